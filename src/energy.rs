@@ -1,0 +1,161 @@
+//! Potential energy of eq. (7)–(11) and the work of point loads (eq. 12–13), with analytic
+//! gradients. All values are dimensionless (units of `Rf/L`).
+//!
+//! - flexure  `½∫ Rf κ²`, `κ² = θ'² + φ'² sin²θ` (eq. 3, 8)
+//! - torsion  `½∫ Rt ω²`, `ω = φ' cosθ + ψ'` (eq. 4, 9)
+//! - extension `½∫ Re ε²` (eq. 10)
+//! - gravity  `∫ D x ds` (eq. 11), evaluated by parts as `x(0)·∫D + ∫ (1+ε) ζₓ(t) ∫ₜᴸ D`.
+
+use crate::layout::Field;
+use crate::model::Model;
+use crate::kinematics::Shape;
+use serde::Serialize;
+
+/// The energy terms of one shape.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct EnergyTerms {
+    /// Flexural energy `U_flex`.
+    pub flexural: f64,
+    /// Torsional energy `U_tor`.
+    pub torsional: f64,
+    /// Extensional energy `U_ext`.
+    pub extensional: f64,
+    /// Gravitational energy `U_grav`.
+    pub gravitational: f64,
+    /// Work `ΣW` done by point loads.
+    pub work: f64,
+}
+
+impl EnergyTerms {
+    /// Potential energy `U` (eq. 7).
+    pub fn potential(&self) -> f64 {
+        self.flexural + self.torsional + self.extensional + self.gravitational
+    }
+
+    /// Internal energy `V = U − ΣW` (eq. 13): what statics minimises.
+    pub fn internal(&self) -> f64 {
+        self.potential() - self.work
+    }
+
+    /// The terms multiplied by `unit` (to convert to the case's units).
+    pub fn scaled(&self, unit: f64) -> EnergyTerms {
+        EnergyTerms {
+            flexural: self.flexural * unit,
+            torsional: self.torsional * unit,
+            extensional: self.extensional * unit,
+            gravitational: self.gravitational * unit,
+            work: self.work * unit,
+        }
+    }
+}
+
+/// Which energy terms enter an objective.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Objective {
+    /// `V = U − ΣW` (statics).
+    Internal,
+    /// `U` alone (path planning).
+    Potential,
+}
+
+impl Model {
+    /// Energy terms of an evaluated shape, and, if `grad` is given, the gradient of the
+    /// objective (`V` or `U`) added to it.
+    pub fn energy(
+        &self,
+        a: &[f64],
+        shape: &Shape,
+        objective: Objective,
+        grad: Option<&mut [f64]>,
+    ) -> EnergyTerms {
+        let lay = &self.layout;
+        let nb = self.nb();
+        let op = lay.offset(Field::Phi);
+        let ops = lay.offset(Field::Psi);
+        let oe = lay.offset(Field::Eps);
+        let spatial = lay.spatial;
+        let mut t = EnergyTerms::default();
+        let mut grad = grad;
+        for q in 0..self.nodes() {
+            let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+            let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
+            let one = 1.0 + eps;
+            let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
+            let omega = dph * ct + dps;
+            t.flexural += 0.5 * wf * (dth * dth + dph * dph * st * st);
+            if spatial {
+                t.torsional += 0.5 * wt * omega * omega;
+            }
+            if oe.is_some() {
+                t.extensional += 0.5 * we * eps * eps;
+            }
+            t.gravitational += wg * one * st * cp;
+            let Some(g) = grad.as_deref_mut() else { continue };
+            let (e, de) = (self.e_at(q), self.de_at(q));
+            // d/dθ (value) and d/dθ' terms
+            let mut g_th = wg * one * ct * cp;
+            let g_dth = wf * dth;
+            if spatial {
+                g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
+            }
+            for i in 0..nb {
+                g[i] += g_th * e[i] + g_dth * de[i];
+            }
+            if let (Some(op), Some(ops)) = (op, ops) {
+                let g_ph = -wg * one * st * sp;
+                let g_dph = wf * dph * st * st + wt * omega * ct;
+                let g_dps = wt * omega;
+                for i in 0..nb {
+                    g[op + i] += g_ph * e[i] + g_dph * de[i];
+                    g[ops + i] += g_dps * de[i];
+                }
+            }
+            if let Some(oe) = oe {
+                let g_e = we * eps + wg * st * cp;
+                for i in 0..nb {
+                    g[oe + i] += g_e * e[i];
+                }
+            }
+        }
+        let base = self.base_position(a);
+        t.gravitational += self.gravity_total * base[0];
+        if let Some(g) = grad.as_deref_mut()
+            && let Some(o) = lay.base_offset()
+        {
+            g[o] += self.gravity_total;
+        }
+        if !self.loads.is_empty() {
+            let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
+            for (ld, &b) in self.loads.iter().zip(&self.load_boundary) {
+                let x = shape.positions[b];
+                t.work += (0..3).map(|k| ld.force[k] * (x[k] - ld.reference[k])).sum::<f64>();
+                for k in 0..3 {
+                    v[b][k] -= ld.force[k];
+                }
+            }
+            if objective == Objective::Internal
+                && let Some(g) = grad
+            {
+                self.add_positions_vjp(a, shape, &v, g);
+            }
+        }
+        t
+    }
+
+    /// Objective value and gradient (overwritten) at `a`; convenience for tests and solvers.
+    pub fn objective_and_gradient(
+        &self,
+        a: &[f64],
+        objective: Objective,
+        shape: &mut Shape,
+        grad: &mut [f64],
+    ) -> f64 {
+        self.evaluate_into(a, shape);
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        let t = self.energy(a, shape, objective, Some(grad));
+        match objective {
+            Objective::Internal => t.internal(),
+            Objective::Potential => t.potential(),
+        }
+    }
+}

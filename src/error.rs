@@ -1,0 +1,42 @@
+//! The library's error type.
+
+use std::path::PathBuf;
+
+/// Errors of the library. Messages name the file, the field and what is wrong.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be read.
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The case file is not valid JSON for the case schema.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// serde's message, with line and column.
+        message: String,
+    },
+    /// A field holds a value that is not allowed.
+    #[error("{path}: field `{field}`: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Dotted path of the field, e.g. `rod.length`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(path: &std::path::Path, field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Invalid { path: path.to_path_buf(), field: field.into(), message: message.into() }
+    }
+}

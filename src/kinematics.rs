@@ -1,0 +1,222 @@
+//! From coefficients to geometry: the four fields at the quadrature nodes, the tangent
+//! `(1+ε)ζ` (eq. 5), positions by cumulative quadrature (eq. 6), frames (eq. 1), and
+//! vector–Jacobian products `Σ_b v_b · ∂x(b)/∂a` computed in one backward pass.
+
+use crate::basis::dot;
+use crate::layout::Field;
+use crate::model::Model;
+
+/// A shape evaluated at the quadrature nodes, with positions at the mesh boundaries.
+#[derive(Clone, Debug, Default)]
+pub struct Shape {
+    /// `θ` at nodes.
+    pub th: Vec<f64>,
+    /// `dθ/dt` at nodes.
+    pub dth: Vec<f64>,
+    /// `φ` at nodes (zero for planar rods).
+    pub ph: Vec<f64>,
+    /// `dφ/dt` at nodes.
+    pub dph: Vec<f64>,
+    /// `dψ/dt` at nodes.
+    pub dps: Vec<f64>,
+    /// `ε` at nodes (zero for inextensible rods).
+    pub eps: Vec<f64>,
+    pub(crate) sth: Vec<f64>,
+    pub(crate) cth: Vec<f64>,
+    pub(crate) sph: Vec<f64>,
+    pub(crate) cph: Vec<f64>,
+    /// Dimensionless positions `x(b)/L` at the mesh boundaries.
+    pub positions: Vec<[f64; 3]>,
+}
+
+impl Model {
+    /// Evaluates the shape of coefficients `a` into `shape` (reusing its buffers).
+    pub fn evaluate_into(&self, a: &[f64], shape: &mut Shape) {
+        let nn = self.nodes();
+        let lay = &self.layout;
+        for v in [
+            &mut shape.th,
+            &mut shape.dth,
+            &mut shape.ph,
+            &mut shape.dph,
+            &mut shape.dps,
+            &mut shape.eps,
+            &mut shape.sth,
+            &mut shape.cth,
+            &mut shape.sph,
+            &mut shape.cph,
+        ] {
+            v.clear();
+            v.resize(nn, 0.0);
+        }
+        let at = lay.field(a, Field::Theta).expect("theta is always present");
+        let ap = lay.field(a, Field::Phi);
+        let aps = lay.field(a, Field::Psi);
+        let ae = lay.field(a, Field::Eps);
+        for q in 0..nn {
+            let (e, de) = (self.e_at(q), self.de_at(q));
+            let th = dot(at, e);
+            shape.th[q] = th;
+            shape.dth[q] = dot(at, de);
+            (shape.sth[q], shape.cth[q]) = th.sin_cos();
+            if let Some(ap) = ap {
+                let ph = dot(ap, e);
+                shape.ph[q] = ph;
+                shape.dph[q] = dot(ap, de);
+                (shape.sph[q], shape.cph[q]) = ph.sin_cos();
+            } else {
+                shape.cph[q] = 1.0;
+            }
+            if let Some(aps) = aps {
+                shape.dps[q] = dot(aps, de);
+            }
+            if let Some(ae) = ae {
+                shape.eps[q] = dot(ae, e);
+            }
+        }
+        let base = self.base_position(a);
+        shape.positions.clear();
+        shape.positions.push(base);
+        let mut x = base;
+        let ps = &self.mesh.panel_start;
+        for j in 0..self.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q] * (1.0 + shape.eps[q]);
+                x[0] += w * shape.sth[q] * shape.cph[q];
+                x[1] += w * shape.sth[q] * shape.sph[q];
+                x[2] += w * shape.cth[q];
+            }
+            shape.positions.push(x);
+        }
+    }
+
+    /// Evaluates the shape of coefficients `a`.
+    pub fn evaluate(&self, a: &[f64]) -> Shape {
+        let mut s = Shape::default();
+        self.evaluate_into(a, &mut s);
+        s
+    }
+
+    /// Dimensionless base position `x(0)/L`: the free unknowns if the base is free, else fixed.
+    pub fn base_position(&self, a: &[f64]) -> [f64; 3] {
+        let mut b = self.base;
+        if let Some(o) = self.layout.base_offset() {
+            for (k, &c) in self.layout.components().iter().enumerate() {
+                b[c] = a[o + k];
+            }
+        }
+        b
+    }
+
+    /// Adds `Σ_b v[b] · ∂x(b)/∂a` to `grad`, for one vector `v[b]` per mesh boundary
+    /// (dimensionless). One backward pass over the nodes: a node's tangent enters every
+    /// position after it, so it sees the suffix sum of the `v`.
+    pub fn add_positions_vjp(&self, a: &[f64], shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
+        let lay = &self.layout;
+        let nb = self.nb();
+        let ot = 0;
+        let op = lay.offset(Field::Phi);
+        let oe = lay.offset(Field::Eps);
+        let ps = &self.mesh.panel_start;
+        let mut suffix = [0.0; 3];
+        let total: [f64; 3] = v.iter().fold([0.0; 3], |acc, x| {
+            [acc[0] + x[0], acc[1] + x[1], acc[2] + x[2]]
+        });
+        if let Some(o) = lay.base_offset() {
+            for (k, &c) in lay.components().iter().enumerate() {
+                grad[o + k] += total[c];
+            }
+        }
+        let _ = a;
+        for j in (0..self.mesh.panels()).rev() {
+            let vb = v[j + 1];
+            suffix = [suffix[0] + vb[0], suffix[1] + vb[1], suffix[2] + vb[2]];
+            if suffix == [0.0; 3] {
+                continue;
+            }
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q];
+                let one = 1.0 + shape.eps[q];
+                let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+                let e = self.e_at(q);
+                // ∂t/∂θ = (1+ε)(cθcφ, cθsφ, −sθ)
+                let gth = w * one * (suffix[0] * ct * cp + suffix[1] * ct * sp - suffix[2] * st);
+                for i in 0..nb {
+                    grad[ot + i] += gth * e[i];
+                }
+                if let Some(op) = op {
+                    // ∂t/∂φ = (1+ε)(−sθsφ, sθcφ, 0)
+                    let gph = w * one * (-suffix[0] * st * sp + suffix[1] * st * cp);
+                    for i in 0..nb {
+                        grad[op + i] += gph * e[i];
+                    }
+                }
+                if let Some(oe) = oe {
+                    let gep = w * (suffix[0] * st * cp + suffix[1] * st * sp + suffix[2] * ct);
+                    for i in 0..nb {
+                        grad[oe + i] += gep * e[i];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Jacobian `∂x(b)/∂a` of the position at boundary `b`: three rows of length `n`.
+    pub fn position_jacobian(&self, a: &[f64], shape: &Shape, b: usize) -> [Vec<f64>; 3] {
+        let n = self.n();
+        let mut rows = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
+        for (k, row) in rows.iter_mut().enumerate() {
+            v[b] = [0.0; 3];
+            v[b][k] = 1.0;
+            self.add_positions_vjp(a, shape, &v, row);
+        }
+        rows
+    }
+
+    /// Euler angles `(φ, θ, ψ)` at dimensionless arc length `t`.
+    pub fn angles_at(&self, a: &[f64], t: f64) -> [f64; 3] {
+        let b = &self.layout.basis;
+        let f = |field| self.layout.field(a, field).map_or(0.0, |c| b.eval(c, t));
+        [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
+    }
+
+    /// Strain `ε` at `t` (zero for inextensible rods).
+    pub fn strain_at(&self, a: &[f64], t: f64) -> f64 {
+        self.layout.field(a, Field::Eps).map_or(0.0, |c| self.layout.basis.eval(c, t))
+    }
+
+    /// Position at an arbitrary `t` (dimensionless), by Gauss quadrature of eq. (6) on `[0, t]`.
+    pub fn position_at(&self, a: &[f64], t: f64) -> [f64; 3] {
+        let shape = self.evaluate(a);
+        let j = self.mesh.boundaries.partition_point(|&b| b <= t).saturating_sub(1);
+        let j = j.min(self.mesh.panels() - 1);
+        let mut x = shape.positions[j];
+        let t0 = self.mesh.boundaries[j];
+        let (gx, gw) = crate::quadrature::gauss_legendre(8);
+        let h = t - t0;
+        for (xi, wi) in gx.iter().zip(&gw) {
+            let u = t0 + 0.5 * h * (xi + 1.0);
+            let [ph, th, _] = self.angles_at(a, u);
+            let one = 1.0 + self.strain_at(a, u);
+            let w = 0.5 * h * wi * one;
+            x[0] += w * th.sin() * ph.cos();
+            x[1] += w * th.sin() * ph.sin();
+            x[2] += w * th.cos();
+        }
+        x
+    }
+}
+
+/// The rotation matrix `A(φ, θ, ψ) = Rz(φ) Ry(θ) Rz(ψ)` of eq. (1), row-major; its columns are
+/// `ξ, η, ζ`.
+pub fn rotation(phi: f64, theta: f64, psi: f64) -> [[f64; 3]; 3] {
+    let (sf, cf) = phi.sin_cos();
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = psi.sin_cos();
+    [
+        [ct * cf * cp - sf * sp, -ct * cf * sp - sf * cp, st * cf],
+        [ct * sf * cp + cf * sp, -ct * sf * sp + cf * cp, st * sf],
+        [-st * cp, st * sp, ct],
+    ]
+}

@@ -1,0 +1,31 @@
+//! # dlo-planner
+//!
+//! Static modelling and deformation path planning of deformable linear objects (cables, wires,
+//! threads, thin strips) after Wakamatsu & Hirai, *Static Modeling of Linear Object Deformation
+//! Based on Differential Geometry* (IJRR 2004).
+//!
+//! A shape is four functions of arc length — Euler angles `φ, θ, ψ` and strain `ε` — each a Ritz
+//! combination of `1, s/L, sin(2πis/L), cos(2πis/L)` ([`basis`]). [`model`] precomputes the
+//! discretised rod, [`kinematics`] turns coefficients into positions and frames, [`energy`]
+//! evaluates eq. (7)–(13) with gradients, [`constraints`] holds the geometric constraints of
+//! §3.2, [`optim`] the generic multiplier method and BFGS, and [`statics`] solves static shapes
+//! and reports reaction forces and stability. [`case`] reads case files.
+//!
+//! The library prints nothing.
+
+pub mod basis;
+pub mod case;
+pub mod constraints;
+pub mod energy;
+pub mod error;
+pub mod kinematics;
+pub mod layout;
+pub mod model;
+pub mod obstacle;
+pub mod optim;
+pub mod problem;
+pub mod quadrature;
+pub mod rod;
+pub mod statics;
+
+pub use error::Error;

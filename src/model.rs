@@ -1,0 +1,151 @@
+//! The discretised rod: Ritz basis values at quadrature nodes and the material properties there,
+//! precomputed once per problem in dimensionless units.
+//!
+//! Scaling (paper §4.3–4.5): arc length `t = s/L`, positions `x/L`, energies in `Rf/L`, forces in
+//! `Rf/L²`, moments in `Rf/L`, where `Rf` is the mean flexural rigidity. The dimensionless
+//! material functions are then `Rf(s)/Rf`, `Rt(s)/Rf` (ρt), `Re(s) L²/Rf` (ρe) and
+//! `D(s) L³/Rf` (ρg).
+
+use crate::layout::Layout;
+use crate::quadrature::Mesh;
+use crate::rod::Rod;
+
+/// A point force `p` applied at `s` (paper eq. 12): it does work `p · (x(s) − x_ref)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointLoad {
+    /// Dimensionless arc length of the point of application.
+    pub t: f64,
+    /// Force in units of `Rf/L²`.
+    pub force: [f64; 3],
+    /// Reference position of the point (dimensionless) from which its displacement is measured.
+    pub reference: [f64; 3],
+}
+
+/// Discretisation settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Discretisation {
+    /// Uniform panels of the composite Gauss–Legendre rule (refined at every needed point).
+    pub panels: usize,
+    /// Gauss points per panel.
+    pub gauss_points: usize,
+}
+
+impl Default for Discretisation {
+    fn default() -> Self {
+        Discretisation { panels: 16, gauss_points: 4 }
+    }
+}
+
+/// The rod model, ready to evaluate shapes and energies.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Physical rod.
+    pub rod: Rod,
+    /// Coefficient layout.
+    pub layout: Layout,
+    /// Quadrature mesh.
+    pub mesh: Mesh,
+    /// Dimensionless base position `x(0)` used when the base is not free.
+    pub base: [f64; 3],
+    /// Point loads (eq. 12–13).
+    pub loads: Vec<PointLoad>,
+    pub(crate) load_boundary: Vec<usize>,
+    /// Basis values, node-major (`nodes × nb`).
+    pub(crate) e: Vec<f64>,
+    /// Basis derivatives `de/dt`, node-major.
+    pub(crate) de: Vec<f64>,
+    /// `w · Rf(t)/Rf`.
+    pub(crate) wf: Vec<f64>,
+    /// `w · Rt(t)/Rf`.
+    pub(crate) wt: Vec<f64>,
+    /// `w · Re(t) L²/Rf`.
+    pub(crate) we: Vec<f64>,
+    /// `w · ∫ₜ¹ D(u) du · L³/Rf`: gravity integrated by parts, `∫ D x ds = x(0)∫D + ∫ ζₓ(t) ∫ₜ¹D`.
+    pub(crate) wg: Vec<f64>,
+    /// `∫₀¹ D L³/Rf`: the base term of the gravitational energy.
+    pub(crate) gravity_total: f64,
+}
+
+impl Model {
+    /// Builds the model. `points` are dimensionless arc lengths where positions are needed
+    /// (constraint points, obstacle samples); they become panel boundaries.
+    pub fn new(
+        rod: Rod,
+        layout: Layout,
+        disc: Discretisation,
+        base: [f64; 3],
+        loads: Vec<PointLoad>,
+        points: &[f64],
+    ) -> Model {
+        let mut all: Vec<f64> = points.to_vec();
+        all.extend(loads.iter().map(|l| l.t));
+        let mesh = Mesh::new(disc.panels, disc.gauss_points, &all);
+        let nb = layout.nb();
+        let nn = mesh.nodes.len();
+        let mut e = vec![0.0; nn * nb];
+        let mut de = vec![0.0; nn * nb];
+        let rf_ref = rod.rf_ref();
+        let l = rod.length;
+        let (mut wf, mut wt, mut we, mut wg) =
+            (vec![0.0; nn], vec![0.0; nn], vec![0.0; nn], vec![0.0; nn]);
+        for (q, (&t, &w)) in mesh.nodes.iter().zip(&mesh.weights).enumerate() {
+            layout.basis.values(t, &mut e[q * nb..(q + 1) * nb]);
+            layout.basis.derivatives(t, &mut de[q * nb..(q + 1) * nb]);
+            wf[q] = w * rod.flexural.at(t) / rf_ref;
+            wt[q] = w * rod.torsional.map_or(0.0, |p| p.at(t)) / rf_ref;
+            we[q] = w * rod.extensional.map_or(0.0, |p| p.at(t)) * l * l / rf_ref;
+            wg[q] = w * rod.weight.integral_from(t) * l.powi(3) / rf_ref;
+        }
+        let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
+        let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
+        Model {
+            rod,
+            layout,
+            mesh,
+            base,
+            loads,
+            load_boundary,
+            e,
+            de,
+            wf,
+            wt,
+            we,
+            wg,
+            gravity_total,
+        }
+    }
+
+    /// Number of unknowns.
+    pub fn n(&self) -> usize {
+        self.layout.len()
+    }
+
+    /// Number of Ritz functions per field.
+    pub fn nb(&self) -> usize {
+        self.layout.nb()
+    }
+
+    /// Number of quadrature nodes.
+    pub fn nodes(&self) -> usize {
+        self.mesh.nodes.len()
+    }
+
+    /// Basis values at node `q`.
+    #[inline]
+    pub(crate) fn e_at(&self, q: usize) -> &[f64] {
+        let nb = self.nb();
+        &self.e[q * nb..(q + 1) * nb]
+    }
+
+    /// Basis derivatives at node `q`.
+    #[inline]
+    pub(crate) fn de_at(&self, q: usize) -> &[f64] {
+        let nb = self.nb();
+        &self.de[q * nb..(q + 1) * nb]
+    }
+
+    /// The boundary index of the mesh point nearest to `t`.
+    pub fn boundary(&self, t: f64) -> usize {
+        self.mesh.boundary_index(t)
+    }
+}

@@ -1,0 +1,178 @@
+//! Rigid obstacles as parry3d-f64 shapes with poses, and the signed distance from a point with
+//! its gradient (the outward normal), in the case's units.
+//!
+//! parry's `distance` is 0 once shapes touch and has no gradient inside, so the signed distance
+//! uses point projection with the inside flag. Half-spaces are evaluated analytically (parry's
+//! contact query mishandles a half-space as second shape). A triangle mesh must be closed and
+//! consistently oriented (built with `ORIENTED`) for inside points to be recognised.
+
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh};
+use std::sync::Arc;
+
+/// Geometry of an obstacle in its local frame.
+#[derive(Clone)]
+pub enum ObstacleShape {
+    /// Box with half extents.
+    Cuboid(Cuboid),
+    /// Sphere.
+    Ball(Ball),
+    /// Capsule between two local points.
+    Capsule(Capsule),
+    /// Cylinder with its axis along local y (parry's convention).
+    Cylinder(Cylinder),
+    /// Convex hull of points.
+    ConvexHull(Arc<ConvexPolyhedron>),
+    /// Closed triangle mesh.
+    TriMesh(Arc<TriMesh>),
+    /// The solid `n · p ≤ 0` in the local frame (`n` the unit outward normal).
+    HalfSpace([f64; 3]),
+}
+
+impl std::fmt::Debug for ObstacleShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = match self {
+            ObstacleShape::Cuboid(_) => "cuboid",
+            ObstacleShape::Ball(_) => "ball",
+            ObstacleShape::Capsule(_) => "capsule",
+            ObstacleShape::Cylinder(_) => "cylinder",
+            ObstacleShape::ConvexHull(_) => "convex_hull",
+            ObstacleShape::TriMesh(_) => "triangle_mesh",
+            ObstacleShape::HalfSpace(_) => "half_space",
+        };
+        f.write_str(name)
+    }
+}
+
+/// An obstacle placed in the world.
+#[derive(Clone, Debug)]
+pub struct Obstacle {
+    /// Name from the case file.
+    pub name: String,
+    /// Local geometry.
+    pub shape: ObstacleShape,
+    /// World position of the local origin.
+    pub position: [f64; 3],
+    /// Rotation as an axis–angle vector (radians).
+    pub rotation: [f64; 3],
+}
+
+fn v3(p: [f64; 3]) -> Vector {
+    Vector::new(p[0], p[1], p[2])
+}
+
+impl Obstacle {
+    /// The parry pose of the obstacle.
+    pub fn pose(&self) -> Pose {
+        Pose::new(v3(self.position), v3(self.rotation))
+    }
+
+    /// Signed distance from world point `p` to the obstacle's surface (negative inside) and its
+    /// gradient with respect to `p` (unit, pointing away from the obstacle).
+    pub fn signed_distance(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
+        let pose = self.pose();
+        let pv = v3(p);
+        let proj = match &self.shape {
+            ObstacleShape::HalfSpace(n) => {
+                let nw = pose.rotation * v3(*n);
+                let d = (pv - pose.translation).dot(nw);
+                return (d, [nw.x, nw.y, nw.z]);
+            }
+            ObstacleShape::Cuboid(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Ball(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Capsule(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Cylinder(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::ConvexHull(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::TriMesh(s) => s.project_point(&pose, pv, false),
+        };
+        let diff = pv - proj.point;
+        let dist = diff.length();
+        if dist < 1e-14 {
+            // On the surface: use a central-difference normal of the unsigned distance field
+            // slightly outside.
+            return (0.0, self.fallback_normal(p));
+        }
+        let n = diff / dist;
+        if proj.is_inside { (-dist, [-n.x, -n.y, -n.z]) } else { (dist, [n.x, n.y, n.z]) }
+    }
+
+    fn fallback_normal(&self, p: [f64; 3]) -> [f64; 3] {
+        let h = 1e-7;
+        let mut g = [0.0; 3];
+        for k in 0..3 {
+            let (mut a, mut b) = (p, p);
+            a[k] += h;
+            b[k] -= h;
+            let (da, _) = self.signed_distance_no_fallback(a);
+            let (db, _) = self.signed_distance_no_fallback(b);
+            g[k] = (da - db) / (2.0 * h);
+        }
+        let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt().max(1e-300);
+        [g[0] / n, g[1] / n, g[2] / n]
+    }
+
+    fn signed_distance_no_fallback(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
+        let pose = self.pose();
+        let pv = v3(p);
+        let proj = match &self.shape {
+            ObstacleShape::HalfSpace(_) => return self.signed_distance(p),
+            ObstacleShape::Cuboid(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Ball(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Capsule(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::Cylinder(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::ConvexHull(s) => s.project_point(&pose, pv, false),
+            ObstacleShape::TriMesh(s) => s.project_point(&pose, pv, false),
+        };
+        let d = (pv - proj.point).length();
+        (if proj.is_inside { -d } else { d }, [0.0; 3])
+    }
+}
+
+/// Reads a Wavefront OBJ file's `v` and `f` records (faces are triangulated as fans; texture and
+/// normal indices are ignored).
+pub fn read_obj(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
+    let mut verts = Vec::new();
+    let mut faces = Vec::new();
+    for (ln, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Result<Vec<f64>, _> = it.take(3).map(str::parse::<f64>).collect();
+                match c {
+                    Ok(c) if c.len() == 3 && c.iter().all(|v| v.is_finite()) => {
+                        verts.push([c[0], c[1], c[2]])
+                    }
+                    _ => return Err(format!("line {}: bad vertex", ln + 1)),
+                }
+            }
+            Some("f") => {
+                let idx: Result<Vec<u32>, String> = it
+                    .map(|tok| {
+                        let i: i64 = tok
+                            .split('/')
+                            .next()
+                            .unwrap_or("")
+                            .parse()
+                            .map_err(|_| format!("line {}: bad face index '{tok}'", ln + 1))?;
+                        let n = verts.len() as i64;
+                        let k = if i < 0 { n + i } else { i - 1 };
+                        if k < 0 || k >= n {
+                            return Err(format!("line {}: face index {i} out of range", ln + 1));
+                        }
+                        Ok(k as u32)
+                    })
+                    .collect();
+                let idx = idx?;
+                if idx.len() < 3 {
+                    return Err(format!("line {}: face with fewer than 3 vertices", ln + 1));
+                }
+                for k in 1..idx.len() - 1 {
+                    faces.push([idx[0], idx[k], idx[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok((verts, faces))
+}

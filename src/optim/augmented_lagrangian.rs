@@ -1,0 +1,362 @@
+//! The multiplier method (augmented Lagrangian, Powell–Hestenes–Rockafellar form) around BFGS.
+//!
+//! Convention: the Lagrangian is `ℒ(x, λ) = f(x) + Σᵢ λᵢ cᵢ(x)`, so at a KKT point
+//! `∇f + Σ λᵢ ∇cᵢ = 0` with `λᵢ ≥ 0` for inequality rows `cᵢ ≤ 0`. The augmented function is
+//!
+//! `Φ(x) = f + Σ_eq (λc + ρc²/2) + Σ_ineq (max(0, μ + ρc)² − μ²)/(2ρ)`
+//!
+//! and the updates are `λ ← λ + ρc`, `μ ← max(0, μ + ρc)`. The penalty `ρ` starts at
+//! [`AlOptions::rho_initial`] (high: a small penalty lets a compressed straight rod sit at its
+//! stationary point), grows ×10 when the violation does not fall to a quarter, and is capped at
+//! [`AlOptions::rho_max`] (beyond it multiplier updates become noise). A final least-squares
+//! estimate of the multipliers from `∇f = −Jᵀλ` on the active set polishes them.
+
+use super::bfgs::{BfgsOptions, BfgsStatus, bfgs};
+use super::nlp::{Nlp, Sense};
+use nalgebra::{DMatrix, DVector};
+
+/// Options of the multiplier method (all tolerances in the problem's own, dimensionless units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlOptions {
+    /// Required constraint violation `max(|c_eq|, max(0, c_ineq))`.
+    pub feasibility_tol: f64,
+    /// Required KKT residual `‖∇f + Jᵀλ‖∞`.
+    pub optimality_tol: f64,
+    /// Initial penalty.
+    pub rho_initial: f64,
+    /// Penalty cap.
+    pub rho_max: f64,
+    /// Outer iteration budget.
+    pub max_outer: usize,
+    /// Inner BFGS iteration budget per outer iteration.
+    pub max_inner: usize,
+    /// An inequality row counts as active when `c > −active_tol` or its multiplier is positive.
+    pub active_tol: f64,
+}
+
+impl Default for AlOptions {
+    fn default() -> Self {
+        AlOptions {
+            feasibility_tol: 1e-9,
+            optimality_tol: 1e-6,
+            rho_initial: 1e3,
+            rho_max: 1e8,
+            max_outer: 40,
+            max_inner: 400,
+            active_tol: 1e-7,
+        }
+    }
+}
+
+/// How the multiplier method ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlStatus {
+    /// Feasible and stationary within tolerance.
+    Converged,
+    /// Budget exhausted before the tolerances were met.
+    IterationLimit,
+    /// The penalty reached its cap and the constraints are still violated.
+    Infeasible,
+    /// A non-finite value appeared.
+    NumericalFailure,
+}
+
+/// Result of [`augmented_lagrangian`].
+#[derive(Clone, Debug)]
+pub struct AlOutcome {
+    /// Termination status.
+    pub status: AlStatus,
+    /// Objective at the solution.
+    pub f: f64,
+    /// Multipliers (`λᵢ ≥ 0` on inequality rows).
+    pub lambda: Vec<f64>,
+    /// Constraint values at the solution.
+    pub c: Vec<f64>,
+    /// `max(|c_eq|, max(0, c_ineq))`.
+    pub max_violation: f64,
+    /// `‖∇f + Jᵀλ‖∞` after the multiplier polish.
+    pub kkt_residual: f64,
+    /// Outer iterations.
+    pub outer_iterations: usize,
+    /// Inner BFGS iterations in total.
+    pub inner_iterations: usize,
+    /// Objective/gradient evaluations in total.
+    pub evaluations: usize,
+    /// Final penalty.
+    pub rho: f64,
+}
+
+/// Constraint violation of values `c`.
+pub fn violation(p: &impl Nlp, c: &[f64]) -> f64 {
+    c.iter().enumerate().fold(0.0, |m, (i, &v)| match p.sense(i) {
+        Sense::Equal => m.max(v.abs()),
+        Sense::LessEq => m.max(v),
+    })
+}
+
+/// Solves `p` from `x` (updated in place), warm-starting the multipliers from `lambda0` if given.
+pub fn augmented_lagrangian<P: Nlp>(
+    p: &mut P,
+    x: &mut [f64],
+    lambda0: Option<&[f64]>,
+    opts: AlOptions,
+) -> AlOutcome {
+    let (n, m) = (p.n(), p.m());
+    let mut lambda = lambda0.map_or(vec![0.0; m], |l| l.to_vec());
+    let mut rho = opts.rho_initial;
+    let mut c = vec![0.0; m];
+    let mut y = vec![0.0; m];
+    let mut h = Vec::new();
+    let mut inner_iterations = 0;
+    let mut evaluations = 0;
+    let mut viol_prev = f64::INFINITY;
+    let mut status = AlStatus::IterationLimit;
+    let mut outer = 0;
+    let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
+    let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
+    while outer < opts.max_outer {
+        outer += 1;
+        let out = {
+            let lam = &lambda;
+            let c = &mut c;
+            let y = &mut y;
+            let p = &mut *p;
+            let senses = &senses;
+            bfgs(
+                |xv, g| {
+                    let f = p.values(xv, c);
+                    let mut phi = f;
+                    for i in 0..m {
+                        match senses[i] {
+                            Sense::Equal => {
+                                phi += lam[i] * c[i] + 0.5 * rho * c[i] * c[i];
+                                y[i] = lam[i] + rho * c[i];
+                            }
+                            Sense::LessEq => {
+                                let t = (lam[i] + rho * c[i]).max(0.0);
+                                phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
+                                y[i] = t;
+                            }
+                        }
+                    }
+                    p.gradient(xv, y, g);
+                    phi
+                },
+                x,
+                &mut h,
+                BfgsOptions { grad_tol: inner_tol, max_iter: opts.max_inner, f_rel_tol: 0.0 },
+            )
+        };
+        inner_iterations += out.iterations;
+        evaluations += out.evaluations;
+        if out.status == BfgsStatus::NumericalFailure {
+            status = AlStatus::NumericalFailure;
+            break;
+        }
+        p.values(x, &mut c);
+        evaluations += 1;
+        let mut viol: f64 = 0.0;
+        for i in 0..m {
+            match senses[i] {
+                Sense::Equal => {
+                    viol = viol.max(c[i].abs());
+                    lambda[i] += rho * c[i];
+                }
+                Sense::LessEq => {
+                    viol = viol.max(c[i].max(-lambda[i] / rho).abs());
+                    lambda[i] = (lambda[i] + rho * c[i]).max(0.0);
+                }
+            }
+        }
+        let inner_ok = out.grad_norm <= opts.optimality_tol
+            || matches!(out.status, BfgsStatus::LineSearchFailed | BfgsStatus::Stalled);
+        if viol <= opts.feasibility_tol && inner_ok && inner_tol <= opts.optimality_tol {
+            status = AlStatus::Converged;
+            break;
+        }
+        if viol > 0.25 * viol_prev {
+            if rho >= opts.rho_max && viol > opts.feasibility_tol && outer > 5 {
+                status = AlStatus::Infeasible;
+                break;
+            }
+            rho = (rho * 10.0).min(opts.rho_max);
+            h.clear();
+        }
+        viol_prev = viol;
+        inner_tol = (inner_tol * 0.1).max(opts.optimality_tol);
+    }
+    let f = p.values(x, &mut c);
+    let polished = polish_multipliers(p, x, &c, &lambda, opts.active_tol);
+    let (lambda, kkt) = match polished {
+        Some((l, r)) if r <= kkt_residual(p, x, &lambda) => (l, r),
+        _ => {
+            let r = kkt_residual(p, x, &lambda);
+            (lambda, r)
+        }
+    };
+    let max_violation = violation(p, &c);
+    if !f.is_finite() {
+        status = AlStatus::NumericalFailure;
+    } else if status == AlStatus::Converged
+        && (kkt > opts.optimality_tol * 10.0 || max_violation > opts.feasibility_tol * 10.0)
+    {
+        status = AlStatus::IterationLimit;
+    } else if status == AlStatus::IterationLimit
+        && max_violation <= opts.feasibility_tol
+        && kkt <= opts.optimality_tol
+    {
+        status = AlStatus::Converged;
+    }
+    let _ = n;
+    AlOutcome {
+        status,
+        f,
+        lambda,
+        c,
+        max_violation,
+        kkt_residual: kkt,
+        outer_iterations: outer,
+        inner_iterations,
+        evaluations,
+        rho,
+    }
+}
+
+/// `‖∇f + Jᵀλ‖∞` at `x`.
+pub fn kkt_residual<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> f64 {
+    let mut c = vec![0.0; p.m()];
+    p.values(x, &mut c);
+    let mut g = vec![0.0; p.n()];
+    p.gradient(x, lambda, &mut g);
+    g.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// Rows of the constraint Jacobian, by differencing `gradient` with unit weights.
+pub fn jacobian_rows<P: Nlp>(p: &mut P, x: &[f64], rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let (n, m) = (p.n(), p.m());
+    let mut c = vec![0.0; m];
+    p.values(x, &mut c);
+    let mut g0 = vec![0.0; n];
+    let zero = vec![0.0; m];
+    p.gradient(x, &zero, &mut g0);
+    let mut y = vec![0.0; m];
+    let mut out = Vec::with_capacity(rows.len());
+    for &r in rows {
+        y[r] = 1.0;
+        let mut g = vec![0.0; n];
+        p.gradient(x, &y, &mut g);
+        y[r] = 0.0;
+        out.push(g.iter().zip(&g0).map(|(a, b)| a - b).collect());
+    }
+    (g0, out)
+}
+
+/// Active rows: every equality row, and inequality rows with `c > −tol` or `λ > 0`.
+pub fn active_rows<P: Nlp>(p: &P, c: &[f64], lambda: &[f64], tol: f64) -> Vec<usize> {
+    (0..p.m())
+        .filter(|&i| match p.sense(i) {
+            Sense::Equal => true,
+            Sense::LessEq => c[i] > -tol || lambda[i] > 0.0,
+        })
+        .collect()
+}
+
+/// Least-squares multipliers `argmin ‖∇f + J_Aᵀλ_A‖` on the active set, dropping inequality rows
+/// whose multiplier comes out negative. Returns the multipliers and the KKT residual.
+fn polish_multipliers<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    c: &[f64],
+    lambda: &[f64],
+    tol: f64,
+) -> Option<(Vec<f64>, f64)> {
+    let m = p.m();
+    if m == 0 {
+        return None;
+    }
+    let mut active = active_rows(p, c, lambda, tol);
+    let (g0, rows_all) = jacobian_rows(p, x, &active);
+    let n = g0.len();
+    let mut rows: Vec<(usize, Vec<f64>)> = active.drain(..).zip(rows_all).collect();
+    for _ in 0..rows.len() + 1 {
+        if rows.is_empty() {
+            break;
+        }
+        let k = rows.len();
+        let jt = DMatrix::from_fn(n, k, |i, j| rows[j].1[i]);
+        let rhs = -DVector::from_column_slice(&g0);
+        let svd = jt.clone().svd(true, true);
+        let sol = svd.solve(&rhs, 1e-12 * svd.singular_values.max().max(1e-300)).ok()?;
+        let worst = (0..k)
+            .filter(|&j| p.sense(rows[j].0) == Sense::LessEq && sol[j] < 0.0)
+            .min_by(|&a, &b| sol[a].total_cmp(&sol[b]));
+        if let Some(j) = worst {
+            rows.remove(j);
+            continue;
+        }
+        let mut lam = vec![0.0; m];
+        for (j, (r, _)) in rows.iter().enumerate() {
+            lam[*r] = sol[j];
+        }
+        let res = &jt * &sol + DVector::from_column_slice(&g0);
+        return Some((lam, res.amax()));
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// min x² + y² s.t. x + y = 1 (λ = −1), and x ≥ 0.8 as −x + 0.8 ≤ 0.
+    struct Toy {
+        with_ineq: bool,
+    }
+    impl Nlp for Toy {
+        fn n(&self) -> usize {
+            2
+        }
+        fn m(&self) -> usize {
+            if self.with_ineq { 2 } else { 1 }
+        }
+        fn sense(&self, i: usize) -> Sense {
+            if i == 0 { Sense::Equal } else { Sense::LessEq }
+        }
+        fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
+            c[0] = x[0] + x[1] - 1.0;
+            if self.with_ineq {
+                c[1] = 0.8 - x[0];
+            }
+            x[0] * x[0] + x[1] * x[1]
+        }
+        fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
+            g[0] = 2.0 * x[0] + y[0];
+            g[1] = 2.0 * x[1] + y[0];
+            if self.with_ineq {
+                g[0] -= y[1];
+            }
+        }
+    }
+
+    #[test]
+    fn equality_multiplier_matches_closed_form() {
+        let mut p = Toy { with_ineq: false };
+        let mut x = vec![0.0, 0.0];
+        let out = augmented_lagrangian(&mut p, &mut x, None, AlOptions::default());
+        assert_eq!(out.status, AlStatus::Converged);
+        assert!((x[0] - 0.5).abs() < 1e-8 && (x[1] - 0.5).abs() < 1e-8);
+        assert!((out.lambda[0] + 1.0).abs() < 1e-8, "{:?}", out.lambda);
+    }
+
+    #[test]
+    fn active_inequality_multiplier_is_positive() {
+        // Solution x = (0.8, 0.2): ∇f = (1.6, 0.4); 1.6 + λ₀ − λ₁ = 0, 0.4 + λ₀ = 0.
+        let mut p = Toy { with_ineq: true };
+        let mut x = vec![0.0, 0.0];
+        let out = augmented_lagrangian(&mut p, &mut x, None, AlOptions::default());
+        assert_eq!(out.status, AlStatus::Converged);
+        assert!((x[0] - 0.8).abs() < 1e-8, "{x:?}");
+        assert!((out.lambda[0] + 0.4).abs() < 1e-7 && (out.lambda[1] - 1.2).abs() < 1e-7);
+    }
+}

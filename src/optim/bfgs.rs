@@ -1,0 +1,235 @@
+//! BFGS with a dense inverse-Hessian approximation (O(n²) per step) and a strong-Wolfe line
+//! search (Nocedal & Wright, Algorithm 6.1). Intended for the 10–300 unknowns of Ritz problems.
+
+use super::line_search::{WolfeParams, strong_wolfe};
+
+/// Options for [`bfgs`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BfgsOptions {
+    /// Stop when `‖∇f‖∞ ≤ grad_tol`.
+    pub grad_tol: f64,
+    /// Iteration budget.
+    pub max_iter: usize,
+    /// Stop when the relative decrease of `f` over an iteration falls below this (0 disables).
+    pub f_rel_tol: f64,
+}
+
+impl Default for BfgsOptions {
+    fn default() -> Self {
+        BfgsOptions { grad_tol: 1e-8, max_iter: 500, f_rel_tol: 0.0 }
+    }
+}
+
+/// Why BFGS stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BfgsStatus {
+    /// The gradient tolerance was met.
+    Converged,
+    /// The relative decrease tolerance was met.
+    Stalled,
+    /// The iteration budget ran out.
+    IterationLimit,
+    /// The line search could not make progress (often: at machine precision).
+    LineSearchFailed,
+    /// A non-finite value appeared.
+    NumericalFailure,
+}
+
+/// Result of [`bfgs`].
+#[derive(Clone, Debug)]
+pub struct BfgsOutcome {
+    /// Final objective value.
+    pub f: f64,
+    /// Final `‖∇f‖∞`.
+    pub grad_norm: f64,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Function evaluations.
+    pub evaluations: usize,
+    /// Termination reason.
+    pub status: BfgsStatus,
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Minimises `f` from `x` (updated in place). `fg(x, g)` returns `f(x)` and writes `∇f(x)`.
+/// `h` is the inverse-Hessian approximation (row-major `n×n`); pass an empty vector to start from
+/// a scaled identity, or a previous one to warm-start.
+pub fn bfgs(
+    mut fg: impl FnMut(&[f64], &mut [f64]) -> f64,
+    x: &mut [f64],
+    h: &mut Vec<f64>,
+    opts: BfgsOptions,
+) -> BfgsOutcome {
+    let n = x.len();
+    let mut g = vec![0.0; n];
+    let mut f = fg(x, &mut g);
+    let mut evals = 1;
+    let fresh = h.len() != n * n;
+    if fresh {
+        *h = vec![0.0; n * n];
+    }
+    let mut d = vec![0.0; n];
+    let mut xn = vec![0.0; n];
+    let mut gn = vec![0.0; n];
+    let mut s = vec![0.0; n];
+    let mut y = vec![0.0; n];
+    let mut hy = vec![0.0; n];
+    let mut first = fresh;
+    let mut iterations = 0;
+    let status = 'outer: {
+        if !f.is_finite() || g.iter().any(|v| !v.is_finite()) {
+            break 'outer BfgsStatus::NumericalFailure;
+        }
+        if fresh {
+            let scale = 1.0 / inf_norm(&g).max(1.0);
+            for i in 0..n {
+                h[i * n + i] = scale;
+            }
+        }
+        for _ in 0..opts.max_iter {
+            iterations += 1;
+            if inf_norm(&g) <= opts.grad_tol {
+                break 'outer BfgsStatus::Converged;
+            }
+            for i in 0..n {
+                d[i] = -(0..n).map(|j| h[i * n + j] * g[j]).sum::<f64>();
+            }
+            let mut d0: f64 = d.iter().zip(&g).map(|(a, b)| a * b).sum();
+            if d0 >= 0.0 {
+                // Not a descent direction: reset to steepest descent.
+                h.iter_mut().for_each(|v| *v = 0.0);
+                let scale = 1.0 / inf_norm(&g).max(1.0);
+                for i in 0..n {
+                    h[i * n + i] = scale;
+                    d[i] = -scale * g[i];
+                }
+                d0 = d.iter().zip(&g).map(|(a, b)| a * b).sum();
+                first = true;
+            }
+            let step = strong_wolfe(
+                |alpha| {
+                    for i in 0..n {
+                        xn[i] = x[i] + alpha * d[i];
+                    }
+                    let fv = fg(&xn, &mut gn);
+                    evals += 1;
+                    let dv = gn.iter().zip(&d).map(|(a, b)| a * b).sum();
+                    (fv, dv)
+                },
+                f,
+                d0,
+                1.0,
+                WolfeParams::default(),
+            );
+            if step.alpha == 0.0 {
+                break 'outer BfgsStatus::LineSearchFailed;
+            }
+            // Re-evaluate at the accepted step if the last trial was elsewhere.
+            for i in 0..n {
+                xn[i] = x[i] + step.alpha * d[i];
+            }
+            let fnew = fg(&xn, &mut gn);
+            evals += 1;
+            for i in 0..n {
+                s[i] = xn[i] - x[i];
+                y[i] = gn[i] - g[i];
+            }
+            let sy: f64 = s.iter().zip(&y).map(|(a, b)| a * b).sum();
+            let f_old = f;
+            x.copy_from_slice(&xn);
+            g.copy_from_slice(&gn);
+            f = fnew;
+            if !f.is_finite() {
+                break 'outer BfgsStatus::NumericalFailure;
+            }
+            if sy > 1e-300 {
+                let yy: f64 = y.iter().map(|v| v * v).sum();
+                if first {
+                    // Nocedal–Wright (6.20): scale the initial matrix before the first update.
+                    h.iter_mut().for_each(|v| *v = 0.0);
+                    for i in 0..n {
+                        h[i * n + i] = sy / yy;
+                    }
+                    first = false;
+                }
+                for i in 0..n {
+                    hy[i] = (0..n).map(|j| h[i * n + j] * y[j]).sum();
+                }
+                let yhy: f64 = y.iter().zip(&hy).map(|(a, b)| a * b).sum();
+                let rho = 1.0 / sy;
+                let c = (1.0 + rho * yhy) * rho;
+                for i in 0..n {
+                    for j in 0..n {
+                        h[i * n + j] += c * s[i] * s[j] - rho * (hy[i] * s[j] + s[i] * hy[j]);
+                    }
+                }
+            }
+            if opts.f_rel_tol > 0.0 && (f_old - f).abs() <= opts.f_rel_tol * f.abs().max(1.0) {
+                break 'outer BfgsStatus::Stalled;
+            }
+        }
+        if inf_norm(&g) <= opts.grad_tol {
+            BfgsStatus::Converged
+        } else {
+            BfgsStatus::IterationLimit
+        }
+    };
+    BfgsOutcome { f, grad_norm: inf_norm(&g), iterations, evaluations: evals, status }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rosenbrock(x: &[f64], g: &mut [f64]) -> f64 {
+        let n = x.len();
+        let mut f = 0.0;
+        g.iter_mut().for_each(|v| *v = 0.0);
+        for i in 0..n - 1 {
+            let a = x[i + 1] - x[i] * x[i];
+            let b = 1.0 - x[i];
+            f += 100.0 * a * a + b * b;
+            g[i] += -400.0 * a * x[i] - 2.0 * b;
+            g[i + 1] += 200.0 * a;
+        }
+        f
+    }
+
+    #[test]
+    fn minimises_rosenbrock() {
+        for n in [2, 5, 10] {
+            let mut x = vec![-1.2; n];
+            let mut h = Vec::new();
+            let out = bfgs(rosenbrock, &mut x, &mut h, BfgsOptions::default());
+            assert_eq!(out.status, BfgsStatus::Converged, "n={n}");
+            for v in &x {
+                assert!((v - 1.0).abs() < 1e-6, "n={n} x={x:?}");
+            }
+            assert!(out.evaluations < 2000);
+        }
+    }
+
+    #[test]
+    fn minimises_quadratic_exactly() {
+        // f = ½ xᵀAx − bᵀx with A = diag(1..10): optimum x = b/A.
+        let fg = |x: &[f64], g: &mut [f64]| {
+            let mut f = 0.0;
+            for i in 0..x.len() {
+                let a = (i + 1) as f64;
+                f += 0.5 * a * x[i] * x[i] - x[i];
+                g[i] = a * x[i] - 1.0;
+            }
+            f
+        };
+        let mut x = vec![0.0; 10];
+        let mut h = Vec::new();
+        let out = bfgs(fg, &mut x, &mut h, BfgsOptions::default());
+        assert_eq!(out.status, BfgsStatus::Converged);
+        for (i, v) in x.iter().enumerate() {
+            assert!((v - 1.0 / (i + 1) as f64).abs() < 1e-9);
+        }
+    }
+}

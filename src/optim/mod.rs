@@ -1,0 +1,12 @@
+//! Generic optimisers. They know nothing of rods: a problem provides values and gradients
+//! through closures or the [`Nlp`] trait.
+
+pub mod augmented_lagrangian;
+pub mod bfgs;
+pub mod line_search;
+pub mod nlp;
+pub mod second_order;
+
+pub use augmented_lagrangian::{AlOptions, AlOutcome, AlStatus, augmented_lagrangian};
+pub use bfgs::{BfgsOptions, BfgsOutcome, BfgsStatus, bfgs};
+pub use nlp::{Nlp, Sense};

@@ -1,0 +1,26 @@
+//! A smooth nonlinear program `min f(x)` subject to `cᵢ(x) = 0` or `cᵢ(x) ≤ 0`.
+
+/// The sense of one constraint row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sense {
+    /// `c(x) = 0`.
+    Equal,
+    /// `c(x) ≤ 0`.
+    LessEq,
+}
+
+/// A nonlinear program. Implementations may cache work between [`Nlp::values`] and
+/// [`Nlp::gradient`] at the same `x`.
+pub trait Nlp {
+    /// Number of unknowns.
+    fn n(&self) -> usize;
+    /// Number of constraint rows.
+    fn m(&self) -> usize;
+    /// Sense of row `i`.
+    fn sense(&self, i: usize) -> Sense;
+    /// Objective `f(x)`; writes `c(x)` into `c`.
+    fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64;
+    /// Writes `∇f(x) + Σᵢ yᵢ ∇cᵢ(x)` into `g`, at the `x` of the last [`Nlp::values`] call.
+    /// Rows with `yᵢ = 0` may be skipped.
+    fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]);
+}

@@ -1,0 +1,63 @@
+//! Second-order check of a KKT point: the Hessian of the Lagrangian, by central differences of
+//! analytic gradients, reduced to the tangent space of the strongly active constraints.
+
+use super::augmented_lagrangian::jacobian_rows;
+use super::nlp::{Nlp, Sense};
+use nalgebra::DMatrix;
+
+/// Eigenvalues of the reduced Hessian `Zᵀ ∇²ℒ Z` (ascending), where `Z` spans the null space of
+/// the Jacobian of the equality rows and of the inequality rows with `λ > lambda_tol`.
+/// Empty when the tangent space is trivial.
+pub fn reduced_hessian_eigenvalues<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    lambda: &[f64],
+    lambda_tol: f64,
+) -> Vec<f64> {
+    let (n, m) = (p.n(), p.m());
+    let mut c = vec![0.0; m];
+    let step = 1e-5;
+    let mut hess = DMatrix::<f64>::zeros(n, n);
+    let mut xp = x.to_vec();
+    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+    for j in 0..n {
+        xp[j] = x[j] + step;
+        p.values(&xp, &mut c);
+        p.gradient(&xp, lambda, &mut gp);
+        xp[j] = x[j] - step;
+        p.values(&xp, &mut c);
+        p.gradient(&xp, lambda, &mut gm);
+        xp[j] = x[j];
+        for i in 0..n {
+            hess[(i, j)] = (gp[i] - gm[i]) / (2.0 * step);
+        }
+    }
+    let hess = 0.5 * (&hess + hess.transpose());
+    let rows: Vec<usize> = (0..m)
+        .filter(|&i| p.sense(i) == Sense::Equal || lambda[i] > lambda_tol)
+        .collect();
+    let z = if rows.is_empty() {
+        DMatrix::identity(n, n)
+    } else {
+        let (_, jr) = jacobian_rows(p, x, &rows);
+        let j = DMatrix::from_fn(rows.len(), n, |r, k| jr[r][k]);
+        null_space(&j)
+    };
+    if z.ncols() == 0 {
+        return Vec::new();
+    }
+    let red = z.transpose() * hess * &z;
+    let mut ev: Vec<f64> = red.symmetric_eigenvalues().iter().copied().collect();
+    ev.sort_by(f64::total_cmp);
+    ev
+}
+
+/// Orthonormal basis of the null space of `j` (via the SVD of `jᵀj`'s eigenvectors).
+pub fn null_space(j: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = j.ncols();
+    let jtj = j.transpose() * j;
+    let eig = jtj.symmetric_eigen();
+    let smax = eig.eigenvalues.amax().max(1e-300);
+    let cols: Vec<usize> = (0..n).filter(|&i| eig.eigenvalues[i] <= 1e-12 * smax).collect();
+    DMatrix::from_fn(n, cols.len(), |r, k| eig.eigenvectors[(r, cols[k])])
+}

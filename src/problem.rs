@@ -1,0 +1,102 @@
+//! A static-shape problem as a nonlinear program: minimise the internal energy `V` of eq. (13)
+//! over the Ritz coefficients subject to the geometric constraints of §3.2.
+
+use crate::constraints::{Adjoint, Constraint};
+use crate::energy::{EnergyTerms, Objective};
+use crate::kinematics::Shape;
+use crate::model::Model;
+use crate::optim::{Nlp, Sense};
+
+/// The rod model plus its constraints.
+#[derive(Clone, Debug)]
+pub struct StaticProblem {
+    /// The rod model.
+    pub model: Model,
+    /// Constraint blocks, in case-file order.
+    pub constraints: Vec<Box<dyn Constraint>>,
+    /// Which energy is minimised.
+    pub objective: Objective,
+    offsets: Vec<usize>,
+    senses: Vec<Sense>,
+    shape: Shape,
+    grad_f: Vec<f64>,
+    adj: Adjoint,
+    terms: EnergyTerms,
+}
+
+impl StaticProblem {
+    /// Assembles a problem.
+    pub fn new(model: Model, constraints: Vec<Box<dyn Constraint>>) -> Self {
+        let mut offsets = vec![0];
+        let mut senses = Vec::new();
+        for c in &constraints {
+            for i in 0..c.rows() {
+                senses.push(c.sense(i));
+            }
+            offsets.push(offsets.last().unwrap() + c.rows());
+        }
+        let adj = Adjoint::new(&model);
+        let n = model.n();
+        StaticProblem {
+            model,
+            constraints,
+            objective: Objective::Internal,
+            offsets,
+            senses,
+            shape: Shape::default(),
+            grad_f: vec![0.0; n],
+            adj,
+            terms: EnergyTerms::default(),
+        }
+    }
+
+    /// Row range of constraint block `k`.
+    pub fn rows_of(&self, k: usize) -> std::ops::Range<usize> {
+        self.offsets[k]..self.offsets[k + 1]
+    }
+
+    /// Energy terms at the last evaluated point.
+    pub fn terms(&self) -> EnergyTerms {
+        self.terms
+    }
+
+    /// Shape at the last evaluated point.
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+}
+
+impl Nlp for StaticProblem {
+    fn n(&self) -> usize {
+        self.model.n()
+    }
+    fn m(&self) -> usize {
+        self.senses.len()
+    }
+    fn sense(&self, i: usize) -> Sense {
+        self.senses[i]
+    }
+    fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
+        self.model.evaluate_into(x, &mut self.shape);
+        self.grad_f.iter_mut().for_each(|g| *g = 0.0);
+        self.terms = self.model.energy(x, &self.shape, self.objective, Some(&mut self.grad_f));
+        for (k, con) in self.constraints.iter().enumerate() {
+            con.values(&self.model, x, &self.shape, &mut c[self.offsets[k]..self.offsets[k + 1]]);
+        }
+        match self.objective {
+            Objective::Internal => self.terms.internal(),
+            Objective::Potential => self.terms.potential(),
+        }
+    }
+    fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
+        g.copy_from_slice(&self.grad_f);
+        self.adj.clear();
+        for (k, con) in self.constraints.iter().enumerate() {
+            let w = &y[self.offsets[k]..self.offsets[k + 1]];
+            if w.iter().any(|v| *v != 0.0) {
+                con.add_gradient(&self.model, x, &self.shape, w, &mut self.adj);
+            }
+        }
+        self.adj.finish(&self.model, x, &self.shape, g);
+    }
+}

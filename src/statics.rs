@@ -1,0 +1,242 @@
+//! Static shapes (paper §4): the multiplier method around BFGS on a [`StaticProblem`], with the
+//! multipliers turned into reaction forces and moments, and a stability verdict.
+
+use crate::energy::EnergyTerms;
+use crate::kinematics::rotation;
+use crate::layout::Field;
+use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
+use crate::optim::second_order::reduced_hessian_eigenvalues;
+use crate::problem::StaticProblem;
+use serde::Serialize;
+
+/// How a static solve ended.
+pub type SolveStatus = AlStatus;
+
+/// Solver settings of a static solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StaticOptions {
+    /// Multiplier-method settings.
+    pub al: AlOptions,
+    /// Whether to compute the stability verdict (costs `2n` gradient evaluations).
+    pub stability: bool,
+    /// Relative tolerance on the reduced Hessian's smallest eigenvalue: the shape is called
+    /// stable when `λ_min > −tol · max(1, |λ_max|)`.
+    pub stability_tol: f64,
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        StaticOptions { al: AlOptions::default(), stability: true, stability_tol: 1e-6 }
+    }
+}
+
+/// The reaction at one constraint, in the case's units: the force (and moment) the support or
+/// contact exerts **on the rod**.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Reaction {
+    /// Constraint label.
+    pub constraint: String,
+    /// Arc length of the point where it acts (case units), when it acts at one point.
+    pub s: Option<f64>,
+    /// Force on the rod.
+    pub force: [f64; 3],
+    /// Moment on the rod (least-squares from the prescribed angles' generalized torques; zero
+    /// for position constraints).
+    pub moment: [f64; 3],
+    /// Generalized torques `(τ_φ, τ_θ, τ_ψ)` conjugate to prescribed Euler angles (zero where the
+    /// angle is free).
+    pub angle_torques: [f64; 3],
+}
+
+/// A solved static shape.
+#[derive(Clone, Debug)]
+pub struct StaticSolution {
+    /// Ritz coefficients.
+    pub a: Vec<f64>,
+    /// Solver status.
+    pub status: SolveStatus,
+    /// Energy terms in the case's units.
+    pub energy: EnergyTerms,
+    /// Energy terms, dimensionless (`Rf/L`).
+    pub energy_scaled: EnergyTerms,
+    /// Multipliers per constraint row (dimensionless, `ℒ = V + Σλc`).
+    pub lambda: Vec<f64>,
+    /// Largest constraint violation (dimensionless; positions in units of `L`).
+    pub max_violation: f64,
+    /// KKT residual `‖∇V + Jᵀλ‖∞` (dimensionless).
+    pub kkt_residual: f64,
+    /// Reactions at each constraint.
+    pub reactions: Vec<Reaction>,
+    /// Stability verdict (`None` if not computed).
+    pub stable: Option<bool>,
+    /// Smallest eigenvalue of the reduced Hessian (dimensionless), if computed.
+    pub min_reduced_eigenvalue: Option<f64>,
+    /// Outer iterations of the multiplier method.
+    pub outer_iterations: usize,
+    /// Objective evaluations.
+    pub evaluations: usize,
+}
+
+/// Solves the static shape of `p` starting from `a0`.
+pub fn solve_static(p: &mut StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticSolution {
+    let mut a = a0.to_vec();
+    let out = augmented_lagrangian(p, &mut a, None, opts.al);
+    finish(p, a, out, opts)
+}
+
+/// Solves with multipliers warm-started from a previous solution (continuation).
+pub fn solve_static_warm(
+    p: &mut StaticProblem,
+    a0: &[f64],
+    lambda0: &[f64],
+    opts: &StaticOptions,
+) -> StaticSolution {
+    let mut a = a0.to_vec();
+    let out = augmented_lagrangian(p, &mut a, Some(lambda0), opts.al);
+    finish(p, a, out, opts)
+}
+
+fn finish(
+    p: &mut StaticProblem,
+    a: Vec<f64>,
+    out: crate::optim::AlOutcome,
+    opts: &StaticOptions,
+) -> StaticSolution {
+    let (stable, min_eig) = if opts.stability && out.status != AlStatus::NumericalFailure {
+        let ev = reduced_hessian_eigenvalues(p, &a, &out.lambda, 1e-8);
+        match (ev.first(), ev.last()) {
+            (Some(&lo), Some(&hi)) => {
+                (Some(lo > -opts.stability_tol * hi.abs().max(1.0)), Some(lo))
+            }
+            _ => (Some(true), None),
+        }
+    } else {
+        (None, None)
+    };
+    let mut c = vec![0.0; crate::optim::Nlp::m(p)];
+    crate::optim::Nlp::values(p, &a, &mut c);
+    let energy_scaled = p.terms();
+    let reactions = reactions(p, &a, &out.lambda);
+    StaticSolution {
+        energy: energy_scaled.scaled(p.model.rod.energy_unit()),
+        energy_scaled,
+        status: out.status,
+        lambda: out.lambda,
+        max_violation: out.max_violation,
+        kkt_residual: out.kkt_residual,
+        reactions,
+        stable,
+        min_reduced_eigenvalue: min_eig,
+        outer_iterations: out.outer_iterations,
+        evaluations: out.evaluations,
+        a,
+    }
+}
+
+/// Converts multipliers into reactions (see [`Reaction`]).
+pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> {
+    use crate::constraints::*;
+    let m = &p.model;
+    let fu = m.rod.force_unit();
+    let mu = m.rod.energy_unit();
+    let l = m.rod.length;
+    let mut out = Vec::new();
+    for (k, con) in p.constraints.iter().enumerate() {
+        let lam = &lambda[p.rows_of(k)];
+        let label = con.label();
+        let mut r = Reaction {
+            constraint: label,
+            s: None,
+            force: [0.0; 3],
+            moment: [0.0; 3],
+            angle_torques: [0.0; 3],
+        };
+        if let Some(pc) = downcast::<PositionConstraint>(con.as_ref()) {
+            r.s = Some(m.mesh.boundaries[pc.boundary] * l);
+            for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
+                let sign = if matches!(b, Bound::AtLeast(_)) { 1.0 } else { -1.0 };
+                r.force[comp] += sign * li * fu;
+            }
+        } else if let Some(rc) = downcast::<RelativePositionConstraint>(con.as_ref()) {
+            r.s = Some(m.mesh.boundaries[rc.to] * l);
+            for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
+                r.force[comp] -= li * fu;
+            }
+        } else if let Some(oc) = downcast::<OrientationConstraint>(con.as_ref()) {
+            r.s = Some(oc.t * l);
+            for (&li, &(f, _)) in lam.iter().zip(&oc.rows) {
+                let idx = match f {
+                    Field::Phi => 0,
+                    Field::Theta => 1,
+                    Field::Psi => 2,
+                    Field::Eps => continue,
+                };
+                r.angle_torques[idx] = -li * mu;
+            }
+            let mut torques = [0.0; 3];
+            for (&li, &(f, _)) in lam.iter().zip(&oc.rows) {
+                match f {
+                    Field::Phi => torques[0] = -li,
+                    Field::Theta => torques[1] = -li,
+                    Field::Psi => torques[2] = -li,
+                    Field::Eps => {}
+                }
+            }
+            r.moment = least_squares_moment(m, a, oc, torques).map(|v| v * mu);
+        } else if let Some(ob) = downcast::<ObstacleConstraint>(con.as_ref()) {
+            let shape = m.evaluate(a);
+            for (&li, &b) in lam.iter().zip(&ob.samples) {
+                if li > 0.0 {
+                    let x = shape.positions[b].map(|v| v * l);
+                    let (_, n) = ob.obstacle.signed_distance(x);
+                    for c in 0..3 {
+                        r.force[c] += li * n[c] * fu;
+                    }
+                }
+            }
+        } else {
+            continue;
+        }
+        out.push(r);
+    }
+    out
+}
+
+fn downcast<T: 'static>(c: &dyn crate::constraints::Constraint) -> Option<&T> {
+    c.as_any().downcast_ref::<T>()
+}
+
+/// Minimum-norm moment `M` with `M·z = τ_φ`, `M·(Rz(φ)ŷ) = τ_θ`, `M·ζ = τ_ψ` for the prescribed
+/// angles (the axes about which each Euler angle rotates the frame).
+fn least_squares_moment(
+    m: &crate::model::Model,
+    a: &[f64],
+    oc: &crate::constraints::OrientationConstraint,
+    torques: [f64; 3],
+) -> [f64; 3] {
+    use nalgebra::{DMatrix, DVector};
+    let [phi, theta, psi] = m.angles_at(a, oc.t);
+    let rot = rotation(phi, theta, psi);
+    let zeta = [rot[0][2], rot[1][2], rot[2][2]];
+    let axes = [[0.0, 0.0, 1.0], [-phi.sin(), phi.cos(), 0.0], zeta];
+    let rows: Vec<usize> = oc
+        .rows
+        .iter()
+        .filter_map(|(f, _)| match f {
+            Field::Phi => Some(0),
+            Field::Theta => Some(1),
+            Field::Psi => Some(2),
+            Field::Eps => None,
+        })
+        .collect();
+    if rows.is_empty() {
+        return [0.0; 3];
+    }
+    let amat = DMatrix::from_fn(rows.len(), 3, |i, j| axes[rows[i]][j]);
+    let b = DVector::from_iterator(rows.len(), rows.iter().map(|&r| torques[r]));
+    let svd = amat.svd(true, true);
+    match svd.solve(&b, 1e-9) {
+        Ok(x) => [x[0], x[1], x[2]],
+        Err(_) => [0.0; 3],
+    }
+}

@@ -1,0 +1,75 @@
+//! Shared helpers for integration tests: closed-form references and small problem builders.
+#![allow(dead_code)]
+
+use dlo_planner::basis::Basis;
+use dlo_planner::constraints::{Bound, Constraint, OrientationConstraint, PositionConstraint};
+use dlo_planner::layout::{Field, Layout};
+use dlo_planner::model::{Discretisation, Model};
+use dlo_planner::problem::StaticProblem;
+use dlo_planner::rod::{Profile, Rod};
+
+/// Complete elliptic integrals `K(m)`, `E(m)` (parameter `m = k²`) by the arithmetic–geometric
+/// mean (Abramowitz & Stegun 17.6).
+pub fn ellip_ke(m: f64) -> (f64, f64) {
+    let (mut a, mut b) = (1.0_f64, (1.0 - m).sqrt());
+    let mut c = m.sqrt();
+    let mut sum = 0.5 * c * c;
+    let mut pow = 0.5;
+    for _ in 0..40 {
+        let an = 0.5 * (a + b);
+        let bn = (a * b).sqrt();
+        c = 0.5 * (a - b);
+        pow *= 2.0;
+        sum += pow * c * c;
+        a = an;
+        b = bn;
+        if c.abs() < 1e-17 {
+            break;
+        }
+    }
+    let k = std::f64::consts::PI / (2.0 * a);
+    (k, k * (1.0 - sum))
+}
+
+/// Pinned–pinned elastica: for end distance ratio `l/L`, the parameter `m` solving
+/// `l/L = 2E(m)/K(m) − 1` (bisection) and the load `P L²/Rf = 4K(m)²`.
+pub fn pinned_elastica_load(ratio: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0_f64, 1.0 - 1e-15);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        let (k, e) = ellip_ke(mid);
+        if 2.0 * e / k - 1.0 > ratio { lo = mid } else { hi = mid }
+    }
+    let (k, _) = ellip_ke(0.5 * (lo + hi));
+    4.0 * k * k
+}
+
+/// A planar inextensible rod of length `l` with `Rf = 1`.
+pub fn planar_rod(length: f64) -> Rod {
+    Rod {
+        length,
+        flexural: Profile::Constant(1.0),
+        torsional: None,
+        extensional: None,
+        weight: Profile::Constant(0.0),
+        radius: 0.05,
+    }
+}
+
+/// Pinned–pinned compression to `ratio·L` with `pairs` basis pairs.
+pub fn pinned_problem(ratio: f64, pairs: usize) -> StaticProblem {
+    let layout = Layout { basis: Basis::new(pairs), spatial: false, extensible: false, free_base: false };
+    let model = Model::new(planar_rod(100.0), layout, Discretisation::default(), [0.0; 3], vec![], &[]);
+    let end = model.boundary(1.0);
+    let c: Vec<Box<dyn Constraint>> = vec![Box::new(PositionConstraint {
+        name: "right pin".into(),
+        boundary: end,
+        rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(ratio))],
+    })];
+    StaticProblem::new(model, c)
+}
+
+/// Clamped at `t = 0` (θ = 0) as an orientation constraint, for tests.
+pub fn clamp(model: &Model, t: f64) -> Box<dyn Constraint> {
+    Box::new(OrientationConstraint::new(model, "clamp".into(), t, vec![(Field::Theta, 0.0)]))
+}
