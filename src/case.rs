@@ -1,1 +1,847 @@
-pub fn _placeholder() {}
+//! Case files: JSON parsed with serde into typed values (`deny_unknown_fields`), then validated
+//! once into a [`Case`] holding a ready [`StaticProblem`]. Every field is documented in the
+//! README with its units and default. Lengths, forces and rigidities are in any one consistent
+//! unit system; angles in radians.
+
+use crate::basis::Basis;
+use crate::constraints::{
+    Bound, Constraint, ObstacleConstraint, OrientationConstraint, PositionConstraint,
+    RelativePositionConstraint, SelfContactConstraint,
+};
+use crate::error::Error;
+use crate::layout::{Field, Layout};
+use crate::model::{Discretisation, Model, PointLoad};
+use crate::obstacle::{Obstacle, ObstacleShape, read_obj};
+use crate::optim::AlOptions;
+use crate::problem::StaticProblem;
+use crate::rod::{Profile, Rod};
+use crate::statics::StaticOptions;
+use parry3d_f64::math::Vector;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The case file as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseFile {
+    /// Case name (default: the file stem); names the log file.
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// The rod.
+    pub rod: RodSpec,
+    /// Planar rod in the x–z plane (`φ = ψ = 0`); default `true`.
+    #[serde(default = "yes")]
+    pub planar: bool,
+    /// Discretisation.
+    #[serde(default)]
+    pub discretisation: DiscretisationSpec,
+    /// Base (`s = 0`) position.
+    #[serde(default)]
+    pub base: BaseSpec,
+    /// Geometric constraints.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
+    /// Point loads.
+    #[serde(default)]
+    pub forces: Vec<ForceSpec>,
+    /// Obstacles.
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleSpec>,
+    /// Enforce self-contact (eq. 17).
+    #[serde(default)]
+    pub self_contact: bool,
+    /// Explicit Ritz coefficients: evaluated by `dlo energy`, the start of `dlo shape`.
+    pub shape: Option<ShapeSpec>,
+    /// Arc lengths at which `dlo energy`/`dlo shape` report positions (default: 0, L/4, …, L).
+    pub report_points: Option<Vec<f64>>,
+    /// Solver settings.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// Path-planning settings (read by `dlo plan`).
+    pub plan: Option<serde_json::Value>,
+    /// Grasp-stability settings (read by `dlo margin`).
+    pub grasp: Option<serde_json::Value>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// `rod` section.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RodSpec {
+    /// Natural length `L` (> 0).
+    pub length: f64,
+    /// `Rf`: number or `{"start", "end"}` (> 0).
+    pub flexural_rigidity: Profile,
+    /// `Rt` (> 0); required when `planar` is false, not allowed when true.
+    pub torsional_rigidity: Option<Profile>,
+    /// `Re` (> 0); absent for an inextensible rod.
+    pub extensional_rigidity: Option<Profile>,
+    /// `D` (≥ 0), weight per unit length; gravity points along −x. Default 0.
+    pub weight_per_length: Option<Profile>,
+    /// Cross-section radius (≥ 0). Default `L/1000`.
+    pub radius: Option<f64>,
+}
+
+/// `discretisation` section.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DiscretisationSpec {
+    /// Sine/cosine pairs per field (paper: 4, i.e. 10 functions).
+    pub basis_pairs: usize,
+    /// Uniform quadrature panels.
+    pub panels: usize,
+    /// Gauss points per panel.
+    pub gauss_points: usize,
+    /// Intervals between obstacle/self-contact sample points.
+    pub samples: usize,
+}
+
+impl Default for DiscretisationSpec {
+    fn default() -> Self {
+        DiscretisationSpec { basis_pairs: 4, panels: 16, gauss_points: 4, samples: 32 }
+    }
+}
+
+/// `base` section.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BaseSpec {
+    /// Position of `P(0)` (the start when free).
+    pub position: [f64; 3],
+    /// When true the base position is an unknown (e.g. a finger that lets the end slide).
+    pub free: bool,
+}
+
+impl Default for BaseSpec {
+    fn default() -> Self {
+        BaseSpec { position: [0.0; 3], free: false }
+    }
+}
+
+/// One coordinate of a position constraint: a number means equality.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum CoordSpec {
+    /// `x_k = v`.
+    Equal(f64),
+    /// Bounds.
+    Range(RangeSpec),
+}
+
+/// One-sided bounds on a coordinate.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSpec {
+    /// `x_k ≥ min`.
+    pub min: Option<f64>,
+    /// `x_k ≤ max`.
+    pub max: Option<f64>,
+}
+
+/// A constraint entry.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ConstraintSpec {
+    /// Position of `P(s)`; omitted coordinates are free.
+    Position {
+        /// Arc length.
+        s: f64,
+        /// x coordinate.
+        x: Option<CoordSpec>,
+        /// y coordinate (spatial rods only).
+        y: Option<CoordSpec>,
+        /// z coordinate.
+        z: Option<CoordSpec>,
+        /// Label in reports.
+        name: Option<String>,
+    },
+    /// `x(s_b) − x(s_a) = l` (eq. 14) for the given components.
+    RelativePosition {
+        /// First point.
+        s_a: f64,
+        /// Second point.
+        s_b: f64,
+        /// `l_x`.
+        x: Option<f64>,
+        /// `l_y`.
+        y: Option<f64>,
+        /// `l_z`.
+        z: Option<f64>,
+        /// Label in reports.
+        name: Option<String>,
+    },
+    /// Euler angles at `P(s)` (eq. 15); omitted angles are free.
+    Orientation {
+        /// Arc length.
+        s: f64,
+        /// φ (spatial only).
+        phi: Option<f64>,
+        /// θ.
+        theta: Option<f64>,
+        /// ψ (spatial only).
+        psi: Option<f64>,
+        /// Label in reports.
+        name: Option<String>,
+    },
+}
+
+/// A point force.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    /// Arc length of the point of application.
+    pub s: f64,
+    /// Force vector.
+    pub force: [f64; 3],
+    /// Position from which the displacement in `W = p·δq` is measured (default: origin).
+    #[serde(default)]
+    pub reference: [f64; 3],
+}
+
+/// An obstacle entry.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    /// Name in reports and logs.
+    pub name: Option<String>,
+    /// Geometry in the local frame.
+    pub shape: ShapeKind,
+    /// World position of the local origin.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Axis–angle rotation vector (radians).
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// Extra clearance beyond the rod radius.
+    #[serde(default)]
+    pub margin: f64,
+}
+
+/// Obstacle geometry.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeKind {
+    /// Box.
+    Cuboid {
+        /// Half extents.
+        half_extents: [f64; 3],
+    },
+    /// Sphere.
+    Ball {
+        /// Radius.
+        radius: f64,
+    },
+    /// Capsule from `a` to `b`.
+    Capsule {
+        /// Segment start.
+        a: [f64; 3],
+        /// Segment end.
+        b: [f64; 3],
+        /// Radius.
+        radius: f64,
+    },
+    /// Cylinder along local y.
+    Cylinder {
+        /// Half height.
+        half_height: f64,
+        /// Radius.
+        radius: f64,
+    },
+    /// Convex hull of points.
+    ConvexHull {
+        /// Points (at least 4, not coplanar).
+        points: Vec<[f64; 3]>,
+    },
+    /// Closed triangle mesh from an OBJ file (path relative to the case file).
+    TriangleMesh {
+        /// OBJ path.
+        obj: PathBuf,
+        /// Uniform scale applied to the vertices.
+        #[serde(default = "one")]
+        scale: f64,
+    },
+    /// Half-space `n·p ≤ 0` (local frame), `n` the outward normal.
+    HalfSpace {
+        /// Outward normal (normalised on load).
+        normal: [f64; 3],
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Explicit Ritz coefficients (basis `1, s/L, sin(2πis/L), cos(2πis/L)`).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeSpec {
+    /// φ coefficients.
+    pub phi: Option<Vec<f64>>,
+    /// θ coefficients.
+    pub theta: Option<Vec<f64>>,
+    /// ψ coefficients.
+    pub psi: Option<Vec<f64>>,
+    /// ε coefficients.
+    pub eps: Option<Vec<f64>>,
+}
+
+/// `solver` section.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    /// Constraint violation tolerance (positions in units of `L`).
+    pub feasibility_tol: f64,
+    /// KKT residual tolerance (energies in units of `Rf/L`).
+    pub optimality_tol: f64,
+    /// Initial penalty (dimensionless).
+    pub rho_initial: f64,
+    /// Penalty cap.
+    pub rho_max: f64,
+    /// Outer iterations.
+    pub max_outer: usize,
+    /// Inner BFGS iterations per outer iteration.
+    pub max_inner: usize,
+    /// Size (radians) of the deterministic perturbation added to the natural state when no
+    /// `shape` is given (the straight rod is stationary, see the README).
+    pub perturbation: f64,
+    /// Compute the stability verdict.
+    pub stability: bool,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        let al = AlOptions::default();
+        SolverSpec {
+            feasibility_tol: al.feasibility_tol,
+            optimality_tol: al.optimality_tol,
+            rho_initial: al.rho_initial,
+            rho_max: al.rho_max,
+            max_outer: al.max_outer,
+            max_inner: al.max_inner,
+            perturbation: 0.1,
+            stability: true,
+        }
+    }
+}
+
+/// A validated case.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Case name.
+    pub name: String,
+    /// Description.
+    pub description: String,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// The static problem.
+    pub problem: StaticProblem,
+    /// Obstacles (also inside the problem's constraints).
+    pub obstacles: Vec<Arc<Obstacle>>,
+    /// Start of the solve, or the shape to evaluate.
+    pub initial: Vec<f64>,
+    /// Whether `initial` came from explicit coefficients.
+    pub explicit_shape: bool,
+    /// Report points (case units).
+    pub report_points: Vec<f64>,
+    /// Static solver options.
+    pub options: StaticOptions,
+    /// Raw `plan` section.
+    pub plan: Option<serde_json::Value>,
+    /// Raw `grasp` section.
+    pub grasp: Option<serde_json::Value>,
+    /// The parsed file.
+    pub file: CaseFile,
+}
+
+/// Reads and validates a case file.
+pub fn load(path: &Path) -> Result<Case, Error> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Io { path: path.to_path_buf(), source: e })?;
+    parse(&text, path)
+}
+
+/// Parses and validates case text; `path` names it in errors and anchors relative paths.
+pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
+    let file: CaseFile = serde_json::from_str(text)
+        .map_err(|e| Error::Parse { path: path.to_path_buf(), message: e.to_string() })?;
+    build(file, path)
+}
+
+struct V<'a> {
+    path: &'a Path,
+}
+
+impl V<'_> {
+    fn err(&self, field: impl Into<String>, msg: impl Into<String>) -> Error {
+        Error::invalid(self.path, field, msg)
+    }
+    fn finite(&self, field: &str, v: f64) -> Result<f64, Error> {
+        if v.is_finite() { Ok(v) } else { Err(self.err(field, format!("must be finite, got {v}"))) }
+    }
+    fn positive(&self, field: &str, v: f64) -> Result<f64, Error> {
+        self.finite(field, v)?;
+        if v > 0.0 { Ok(v) } else { Err(self.err(field, format!("must be positive, got {v}"))) }
+    }
+    fn profile_positive(&self, field: &str, p: &Profile) -> Result<(), Error> {
+        if !p.is_finite() {
+            return Err(self.err(field, "must be finite"));
+        }
+        if p.min() <= 0.0 {
+            return Err(self.err(field, format!("must be positive along the rod, got minimum {}", p.min())));
+        }
+        Ok(())
+    }
+    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<[f64; 3], Error> {
+        for (k, c) in v.iter().enumerate() {
+            self.finite(&format!("{field}[{k}]"), *c)?;
+        }
+        Ok(v)
+    }
+    fn arc(&self, field: &str, s: f64, l: f64) -> Result<f64, Error> {
+        self.finite(field, s)?;
+        if !(0.0..=l).contains(&s) {
+            return Err(self.err(field, format!("arc length {s} outside [0, {l}]")));
+        }
+        Ok(s / l)
+    }
+}
+
+fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
+    let v = V { path };
+    let r = &file.rod;
+    let l = v.positive("rod.length", r.length)?;
+    v.profile_positive("rod.flexural_rigidity", &r.flexural_rigidity)?;
+    if let Some(p) = &r.torsional_rigidity {
+        if file.planar {
+            return Err(v.err("rod.torsional_rigidity", "not used by a planar rod: remove it or set \"planar\": false"));
+        }
+        v.profile_positive("rod.torsional_rigidity", p)?;
+    } else if !file.planar {
+        return Err(v.err("rod.torsional_rigidity", "required for a spatial rod (\"planar\": false)"));
+    }
+    if let Some(p) = &r.extensional_rigidity {
+        v.profile_positive("rod.extensional_rigidity", p)?;
+    }
+    let weight = r.weight_per_length.unwrap_or(Profile::Constant(0.0));
+    if !weight.is_finite() || weight.min() < 0.0 {
+        return Err(v.err("rod.weight_per_length", "must be finite and non-negative"));
+    }
+    let radius = r.radius.unwrap_or(l / 1000.0);
+    v.finite("rod.radius", radius)?;
+    if radius < 0.0 || radius >= 0.5 * l {
+        return Err(v.err("rod.radius", format!("must be in [0, L/2), got {radius}")));
+    }
+    let d = file.discretisation;
+    if !(0..=32).contains(&d.basis_pairs) {
+        return Err(v.err("discretisation.basis_pairs", format!("must be in 0..=32, got {}", d.basis_pairs)));
+    }
+    if !(1..=2000).contains(&d.panels) {
+        return Err(v.err("discretisation.panels", format!("must be in 1..=2000, got {}", d.panels)));
+    }
+    if !(1..=16).contains(&d.gauss_points) {
+        return Err(v.err("discretisation.gauss_points", format!("must be in 1..=16, got {}", d.gauss_points)));
+    }
+    if !(1..=2000).contains(&d.samples) {
+        return Err(v.err("discretisation.samples", format!("must be in 1..=2000, got {}", d.samples)));
+    }
+    let rod = Rod {
+        length: l,
+        flexural: r.flexural_rigidity,
+        torsional: r.torsional_rigidity,
+        extensional: r.extensional_rigidity,
+        weight,
+        radius,
+    };
+    let layout = Layout {
+        basis: Basis::new(d.basis_pairs),
+        spatial: !file.planar,
+        extensible: r.extensional_rigidity.is_some(),
+        free_base: file.base.free,
+    };
+    let base = v.vec3("base.position", file.base.position)?;
+    if file.planar && base[1] != 0.0 {
+        return Err(v.err("base.position[1]", "a planar rod lies in the x–z plane: y must be 0"));
+    }
+
+    // Points where positions are needed.
+    let mut points: Vec<f64> = (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect();
+    for (i, c) in file.constraints.iter().enumerate() {
+        match c {
+            ConstraintSpec::Position { s, .. } | ConstraintSpec::Orientation { s, .. } => {
+                points.push(v.arc(&format!("constraints[{i}].s"), *s, l)?)
+            }
+            ConstraintSpec::RelativePosition { s_a, s_b, .. } => {
+                points.push(v.arc(&format!("constraints[{i}].s_a"), *s_a, l)?);
+                points.push(v.arc(&format!("constraints[{i}].s_b"), *s_b, l)?);
+            }
+        }
+    }
+    let fu = rod.force_unit();
+    let mut loads = Vec::new();
+    for (i, f) in file.forces.iter().enumerate() {
+        let t = v.arc(&format!("forces[{i}].s"), f.s, l)?;
+        let force = v.vec3(&format!("forces[{i}].force"), f.force)?;
+        let reference = v.vec3(&format!("forces[{i}].reference"), f.reference)?;
+        if file.planar && force[1] != 0.0 {
+            return Err(v.err(format!("forces[{i}].force[1]"), "a planar rod cannot take a y force"));
+        }
+        loads.push(PointLoad { t, force: force.map(|c| c / fu), reference: reference.map(|c| c / l) });
+    }
+    let disc = Discretisation { panels: d.panels, gauss_points: d.gauss_points };
+    let model = Model::new(rod.clone(), layout, disc, base.map(|c| c / l), loads, &points);
+
+    let mut constraints: Vec<Box<dyn Constraint>> = Vec::new();
+    // Fixed points for the reachability check: (t, position, all components fixed).
+    let mut fixed: Vec<(f64, [f64; 3])> = Vec::new();
+    if !file.base.free {
+        fixed.push((0.0, base));
+    }
+    let comps = layout.components();
+    for (i, c) in file.constraints.iter().enumerate() {
+        let field = |f: &str| format!("constraints[{i}].{f}");
+        match c {
+            ConstraintSpec::Position { s, x, y, z, name } => {
+                let t = s / l;
+                let mut rows = Vec::new();
+                let mut fixed_pos = [0.0; 3];
+                let mut all_fixed = true;
+                for (k, (nm, cs)) in [("x", x), ("y", y), ("z", z)].into_iter().enumerate() {
+                    let Some(cs) = cs else {
+                        if comps.contains(&k) {
+                            all_fixed = false;
+                        }
+                        continue;
+                    };
+                    if !comps.contains(&k) {
+                        return Err(v.err(field(nm), "a planar rod lies in the x–z plane: remove y"));
+                    }
+                    match *cs {
+                        CoordSpec::Equal(val) => {
+                            v.finite(&field(nm), val)?;
+                            rows.push((k, Bound::Equal(val / l)));
+                            fixed_pos[k] = val;
+                        }
+                        CoordSpec::Range(RangeSpec { min, max }) => {
+                            all_fixed = false;
+                            if min.is_none() && max.is_none() {
+                                return Err(v.err(field(nm), "give a number, or \"min\" and/or \"max\""));
+                            }
+                            if let Some(mn) = min {
+                                v.finite(&format!("{}.min", field(nm)), mn)?;
+                                rows.push((k, Bound::AtLeast(mn / l)));
+                            }
+                            if let Some(mx) = max {
+                                v.finite(&format!("{}.max", field(nm)), mx)?;
+                                rows.push((k, Bound::AtMost(mx / l)));
+                            }
+                            if let (Some(mn), Some(mx)) = (min, max)
+                                && mn > mx
+                            {
+                                return Err(v.err(field(nm), format!("min {mn} exceeds max {mx}")));
+                            }
+                        }
+                    }
+                }
+                if rows.is_empty() {
+                    return Err(v.err(format!("constraints[{i}]"), "a position constraint needs at least one of x, y, z"));
+                }
+                if all_fixed {
+                    fixed.push((t, fixed_pos));
+                }
+                constraints.push(Box::new(PositionConstraint {
+                    name: name.clone().unwrap_or_else(|| format!("position at s={s}")),
+                    boundary: model.boundary(t),
+                    rows,
+                }));
+            }
+            ConstraintSpec::RelativePosition { s_a, s_b, x, y, z, name } => {
+                let mut rows = Vec::new();
+                let mut vec = [0.0; 3];
+                for (k, (nm, val)) in [("x", x), ("y", y), ("z", z)].into_iter().enumerate() {
+                    let Some(val) = val else { continue };
+                    if !comps.contains(&k) {
+                        return Err(v.err(field(nm), "a planar rod lies in the x–z plane: remove y"));
+                    }
+                    v.finite(&field(nm), *val)?;
+                    rows.push((k, val / l));
+                    vec[k] = *val;
+                }
+                if rows.is_empty() {
+                    return Err(v.err(format!("constraints[{i}]"), "a relative position needs at least one of x, y, z"));
+                }
+                if rows.len() == comps.len() && !layout.extensible {
+                    let dist = vec.iter().map(|c| c * c).sum::<f64>().sqrt();
+                    if dist > (s_b - s_a).abs() * (1.0 + 1e-12) {
+                        return Err(v.err(format!("constraints[{i}]"), format!(
+                            "unreachable: points {} apart along an inextensible rod cannot be {dist} apart",
+                            (s_b - s_a).abs()
+                        )));
+                    }
+                }
+                constraints.push(Box::new(RelativePositionConstraint {
+                    name: name.clone().unwrap_or_else(|| format!("relative position {s_a}→{s_b}")),
+                    from: model.boundary(s_a / l),
+                    to: model.boundary(s_b / l),
+                    rows,
+                }));
+            }
+            ConstraintSpec::Orientation { s, phi, theta, psi, name } => {
+                let mut rows = Vec::new();
+                for (nm, f, val) in [("phi", Field::Phi, phi), ("theta", Field::Theta, theta), ("psi", Field::Psi, psi)] {
+                    let Some(val) = val else { continue };
+                    if layout.offset(f).is_none() {
+                        return Err(v.err(field(nm), "a planar rod has only theta"));
+                    }
+                    v.finite(&field(nm), *val)?;
+                    rows.push((f, *val));
+                }
+                if rows.is_empty() {
+                    return Err(v.err(format!("constraints[{i}]"), "an orientation constraint needs at least one angle"));
+                }
+                constraints.push(Box::new(OrientationConstraint::new(
+                    &model,
+                    name.clone().unwrap_or_else(|| format!("orientation at s={s}")),
+                    s / l,
+                    rows,
+                )));
+            }
+        }
+    }
+    if !layout.extensible {
+        for (i, (ta, pa)) in fixed.iter().enumerate() {
+            for (tb, pb) in &fixed[i + 1..] {
+                let dist = (0..3).map(|k| (pa[k] - pb[k]).powi(2)).sum::<f64>().sqrt();
+                let arc = (tb - ta).abs() * l;
+                if dist > arc * (1.0 + 1e-12) + 1e-12 * l {
+                    return Err(v.err("constraints", format!(
+                        "unreachable: the points at s={} and s={} are {dist} apart but only {arc} of inextensible rod joins them",
+                        ta * l, tb * l
+                    )));
+                }
+            }
+        }
+    }
+
+    let samples: Vec<usize> = (0..=d.samples).map(|j| model.boundary(j as f64 / d.samples as f64)).collect();
+    let mut obstacles = Vec::new();
+    for (i, o) in file.obstacles.iter().enumerate() {
+        let f = |x: &str| format!("obstacles[{i}].{x}");
+        let shape = build_shape(&v, &o.shape, &f("shape"), path)?;
+        let position = v.vec3(&f("position"), o.position)?;
+        let rotation = v.vec3(&f("rotation"), o.rotation)?;
+        let margin = v.finite(&f("margin"), o.margin)?;
+        if margin < 0.0 {
+            return Err(v.err(f("margin"), "must be non-negative"));
+        }
+        let ob = Arc::new(Obstacle {
+            name: o.name.clone().unwrap_or_else(|| format!("obstacle{i}")),
+            shape,
+            position,
+            rotation,
+        });
+        obstacles.push(ob.clone());
+        constraints.push(Box::new(ObstacleConstraint {
+            obstacle: ob,
+            samples: samples.clone(),
+            clearance: (radius + margin) / l,
+            length: l,
+        }));
+    }
+    if file.self_contact {
+        let ts: Vec<f64> = (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect();
+        constraints.push(Box::new(SelfContactConstraint::new(samples.clone(), &ts, 2.0 * radius / l)));
+    }
+
+    let (initial, explicit_shape) = match &file.shape {
+        Some(sh) => (coefficients(&v, sh, &layout, base.map(|c| c / l))?, true),
+        None => (default_start(&layout, file.solver.perturbation, base.map(|c| c / l)), false),
+    };
+    let report_points = match &file.report_points {
+        Some(p) => {
+            for (i, s) in p.iter().enumerate() {
+                v.arc(&format!("report_points[{i}]"), *s, l)?;
+            }
+            p.clone()
+        }
+        None => (0..=4).map(|j| j as f64 * l / 4.0).collect(),
+    };
+    let sv = file.solver;
+    for (nm, val) in [
+        ("solver.feasibility_tol", sv.feasibility_tol),
+        ("solver.optimality_tol", sv.optimality_tol),
+        ("solver.rho_initial", sv.rho_initial),
+        ("solver.rho_max", sv.rho_max),
+    ] {
+        v.positive(nm, val)?;
+    }
+    v.finite("solver.perturbation", sv.perturbation)?;
+    if sv.rho_max < sv.rho_initial {
+        return Err(v.err("solver.rho_max", "must be at least solver.rho_initial"));
+    }
+    if sv.max_outer == 0 || sv.max_inner == 0 {
+        return Err(v.err("solver.max_outer", "iteration budgets must be positive"));
+    }
+    let options = StaticOptions {
+        al: AlOptions {
+            feasibility_tol: sv.feasibility_tol,
+            optimality_tol: sv.optimality_tol,
+            rho_initial: sv.rho_initial,
+            rho_max: sv.rho_max,
+            max_outer: sv.max_outer,
+            max_inner: sv.max_inner,
+            ..AlOptions::default()
+        },
+        stability: sv.stability,
+        ..StaticOptions::default()
+    };
+    let name = file.name.clone().unwrap_or_else(|| {
+        path.file_stem().map_or("case".into(), |s| s.to_string_lossy().into_owned())
+    });
+    if name.is_empty() || name.contains(['/', '\\']) {
+        return Err(v.err("name", "must be non-empty and contain no path separators"));
+    }
+    Ok(Case {
+        name,
+        description: file.description.clone(),
+        path: path.to_path_buf(),
+        problem: StaticProblem::new(model, constraints),
+        obstacles,
+        initial,
+        explicit_shape,
+        report_points,
+        options,
+        plan: file.plan.clone(),
+        grasp: file.grasp.clone(),
+        file,
+    })
+}
+
+fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<ObstacleShape, Error> {
+    let vv = |p: [f64; 3]| Vector::new(p[0], p[1], p[2]);
+    Ok(match s {
+        ShapeKind::Cuboid { half_extents } => {
+            for (k, h) in half_extents.iter().enumerate() {
+                v.positive(&format!("{field}.half_extents[{k}]"), *h)?;
+            }
+            ObstacleShape::Cuboid(Cuboid::new(vv(*half_extents)))
+        }
+        ShapeKind::Ball { radius } => {
+            ObstacleShape::Ball(Ball::new(v.positive(&format!("{field}.radius"), *radius)?))
+        }
+        ShapeKind::Capsule { a, b, radius } => {
+            v.vec3(&format!("{field}.a"), *a)?;
+            v.vec3(&format!("{field}.b"), *b)?;
+            let r = v.positive(&format!("{field}.radius"), *radius)?;
+            ObstacleShape::Capsule(Capsule::new(vv(*a), vv(*b), r))
+        }
+        ShapeKind::Cylinder { half_height, radius } => {
+            let h = v.positive(&format!("{field}.half_height"), *half_height)?;
+            let r = v.positive(&format!("{field}.radius"), *radius)?;
+            ObstacleShape::Cylinder(Cylinder::new(h, r))
+        }
+        ShapeKind::ConvexHull { points } => {
+            for (i, p) in points.iter().enumerate() {
+                v.vec3(&format!("{field}.points[{i}]"), *p)?;
+            }
+            if points.len() < 4 {
+                return Err(v.err(format!("{field}.points"), "a convex hull needs at least 4 points"));
+            }
+            let pts: Vec<Vector> = points.iter().map(|p| vv(*p)).collect();
+            let hull = ConvexPolyhedron::from_convex_hull(&pts)
+                .ok_or_else(|| v.err(format!("{field}.points"), "points are degenerate (coplanar?): no convex hull"))?;
+            ObstacleShape::ConvexHull(Arc::new(hull))
+        }
+        ShapeKind::TriangleMesh { obj, scale } => {
+            let sc = v.positive(&format!("{field}.scale"), *scale)?;
+            let full = case_path.parent().unwrap_or(Path::new(".")).join(obj);
+            let text = std::fs::read_to_string(&full).map_err(|e| {
+                v.err(format!("{field}.obj"), format!("cannot read {}: {e}", full.display()))
+            })?;
+            let (verts, faces) = read_obj(&text)
+                .map_err(|e| v.err(format!("{field}.obj"), format!("{}: {e}", full.display())))?;
+            if verts.is_empty() || faces.is_empty() {
+                return Err(v.err(format!("{field}.obj"), format!("{}: the mesh has no triangles", full.display())));
+            }
+            let verts: Vec<Vector> = verts.iter().map(|p| vv(p.map(|c| c * sc))).collect();
+            let mesh = TriMesh::with_flags(
+                verts,
+                faces,
+                TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::FIX_INTERNAL_EDGES,
+            )
+            .map_err(|e| v.err(format!("{field}.obj"), format!("{}: invalid mesh: {e:?}", full.display())))?;
+            ObstacleShape::TriMesh(Arc::new(mesh))
+        }
+        ShapeKind::HalfSpace { normal } => {
+            let n = v.vec3(&format!("{field}.normal"), *normal)?;
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if len < 1e-12 {
+                return Err(v.err(format!("{field}.normal"), "must be non-zero"));
+            }
+            ObstacleShape::HalfSpace(n.map(|c| c / len))
+        }
+    })
+}
+
+fn coefficients(v: &V, sh: &ShapeSpec, layout: &Layout, base: [f64; 3]) -> Result<Vec<f64>, Error> {
+    let mut a = vec![0.0; layout.len()];
+    let nb = layout.nb();
+    for (nm, f, vals) in [
+        ("phi", Field::Phi, &sh.phi),
+        ("theta", Field::Theta, &sh.theta),
+        ("psi", Field::Psi, &sh.psi),
+        ("eps", Field::Eps, &sh.eps),
+    ] {
+        let Some(vals) = vals else { continue };
+        let field = format!("shape.{nm}");
+        let off = layout.offset(f).ok_or_else(|| {
+            v.err(&field, if f == Field::Eps { "the rod is inextensible (no extensional_rigidity)" } else { "a planar rod has only theta (and eps)" })
+        })?;
+        if vals.len() != nb {
+            return Err(v.err(&field, format!("expected {nb} coefficients (2 + 2·basis_pairs), got {}", vals.len())));
+        }
+        for (i, c) in vals.iter().enumerate() {
+            a[off + i] = v.finite(&format!("{field}[{i}]"), *c)?;
+        }
+    }
+    if let Some(o) = layout.base_offset() {
+        for (k, &c) in layout.components().iter().enumerate() {
+            a[o + k] = base[c];
+        }
+    }
+    Ok(a)
+}
+
+/// The natural state plus a deterministic perturbation of size `delta` radians: a bulge
+/// `θ = δ(1 − 2t)` plus small multiples of the other modes, so that no symmetry of the problem
+/// survives (a symmetric start converges to a symmetric, possibly unstable, equilibrium).
+pub fn default_start(layout: &Layout, delta: f64, base: [f64; 3]) -> Vec<f64> {
+    let mut a = vec![0.0; layout.len()];
+    let nb = layout.nb();
+    a[0] = delta;
+    a[1] = -2.0 * delta;
+    for i in 2..nb {
+        a[i] = delta * 0.05 * (1.0 + (i as f64 * 0.7).sin());
+    }
+    if let Some(o) = layout.offset(Field::Phi) {
+        a[o] = 0.3;
+        for i in 2..nb {
+            a[o + i] = delta * 0.05 * (i as f64 * 1.3).cos();
+        }
+    }
+    if let Some(o) = layout.offset(Field::Psi) {
+        a[o] = -0.3;
+    }
+    if let Some(o) = layout.base_offset() {
+        for (k, &c) in layout.components().iter().enumerate() {
+            a[o + k] = base[c];
+        }
+    }
+    a
+}

@@ -25,6 +25,7 @@ pub mod obstacle;
 pub mod optim;
 pub mod problem;
 pub mod quadrature;
+pub mod report;
 pub mod rod;
 pub mod statics;
 

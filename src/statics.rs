@@ -240,3 +240,19 @@ fn least_squares_moment(
         Err(_) => [0.0; 3],
     }
 }
+
+/// Evaluates the given coefficients without optimising: energy terms, constraint violation, and
+/// the least-squares multipliers `argmin ‖∇V + Jᵀλ‖` (the reactions the shape would need if it
+/// were an equilibrium; the returned KKT residual says how far it is from one).
+pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> (EnergyTerms, f64, Vec<Reaction>, f64) {
+    use crate::optim::Nlp;
+    use crate::optim::augmented_lagrangian::{kkt_residual, least_squares_multipliers, violation};
+    let mut c = vec![0.0; p.m()];
+    p.values(a, &mut c);
+    let terms = p.terms();
+    let viol = violation(p, &c);
+    let zero = vec![0.0; p.m()];
+    let (lambda, kkt) = least_squares_multipliers(p, a, &c, &zero, 1e-7)
+        .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
+    (terms.scaled(p.model.rod.energy_unit()), viol, reactions(p, a, &lambda), kkt)
+}

@@ -23,3 +23,47 @@ fn pinned_reaction_matches_elastica_at_default_basis() {
         assert!((p - exact).abs() / exact < 1e-3);
     }
 }
+
+#[test]
+fn reaction_error_falls_as_the_basis_grows() {
+    for ratio in [0.95, 0.60] {
+        let exact = pinned_elastica_load(ratio) / 100.0_f64.powi(2);
+        let errs: Vec<f64> = [1, 2, 3, 4, 6, 8]
+            .iter()
+            .map(|&pairs| {
+                let (p, sol) = buckle(ratio, pairs);
+                assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+                (p - exact).abs() / exact
+            })
+            .collect();
+        eprintln!("l/L = {ratio}: relative errors for 1, 2, 3, 4, 6, 8 pairs: {errs:?}");
+        for w in errs.windows(2) {
+            assert!(w[1] < w[0], "error must fall as the basis grows: {errs:?}");
+        }
+        assert!(errs[5] < 1e-4, "{errs:?}");
+    }
+}
+
+#[test]
+fn clamped_load_is_four_times_pinned() {
+    // Clamped–clamped elastica of length L = two pinned ones of length L/2 back to back:
+    // P_clamped = 4 P_pinned at the same l/L.
+    use dlo_planner::constraints::{Bound, Constraint, PositionConstraint};
+    let exact = 4.0 * pinned_elastica_load(0.6) / 100.0_f64.powi(2);
+    let p0 = pinned_problem(0.6, 4);
+    let model = p0.model.clone();
+    let c: Vec<Box<dyn Constraint>> = vec![
+        clamp(&model, 0.0),
+        Box::new(PositionConstraint { name: "end".into(), boundary: model.boundary(1.0), rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(0.6))] }),
+        clamp(&model, 1.0),
+    ];
+    let mut p = dlo_planner::problem::StaticProblem::new(model, c);
+    let mut a0 = vec![0.0; p.model.n()];
+    a0[2] = 0.1;
+    let sol = solve_static(&mut p, &a0, &StaticOptions::default());
+    let f = sol.reactions[1].force;
+    let load = (f[0] * f[0] + f[2] * f[2]).sqrt();
+    eprintln!("clamped: {load:.6e} vs {exact:.6e}");
+    assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+    assert!((load - exact).abs() / exact < 1e-3);
+}

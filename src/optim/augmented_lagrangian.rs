@@ -187,7 +187,7 @@ pub fn augmented_lagrangian<P: Nlp>(
         inner_tol = (inner_tol * 0.1).max(opts.optimality_tol);
     }
     let f = p.values(x, &mut c);
-    let polished = polish_multipliers(p, x, &c, &lambda, opts.active_tol);
+    let polished = least_squares_multipliers(p, x, &c, &lambda, opts.active_tol);
     let (lambda, kkt) = match polished {
         Some((l, r)) if r <= kkt_residual(p, x, &lambda) => (l, r),
         _ => {
@@ -263,8 +263,9 @@ pub fn active_rows<P: Nlp>(p: &P, c: &[f64], lambda: &[f64], tol: f64) -> Vec<us
 }
 
 /// Least-squares multipliers `argmin ‖∇f + J_Aᵀλ_A‖` on the active set, dropping inequality rows
-/// whose multiplier comes out negative. Returns the multipliers and the KKT residual.
-fn polish_multipliers<P: Nlp>(
+/// whose multiplier comes out negative. Returns the multipliers and the KKT residual, `None` when
+/// there are no constraints.
+pub fn least_squares_multipliers<P: Nlp>(
     p: &mut P,
     x: &[f64],
     c: &[f64],

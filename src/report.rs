@@ -1,0 +1,133 @@
+//! Machine-readable summaries of solves, shared by the CLI's `--json` output and tests.
+
+use crate::energy::EnergyTerms;
+use crate::kinematics::rotation;
+use crate::problem::StaticProblem;
+use crate::statics::{Reaction, StaticSolution};
+use serde::Serialize;
+
+/// Energy terms in the case's units, with their total `U` and the internal energy `V = U − W`.
+#[derive(Clone, Debug, Serialize)]
+pub struct EnergyReport {
+    /// `U = U_flex + U_tor + U_ext + U_grav`.
+    pub total: f64,
+    /// `U_flex`.
+    pub flexural: f64,
+    /// `U_tor`.
+    pub torsional: f64,
+    /// `U_ext`.
+    pub extensional: f64,
+    /// `U_grav`.
+    pub gravitational: f64,
+    /// `ΣW` of point loads.
+    pub work: f64,
+    /// `V = U − ΣW`.
+    pub internal: f64,
+}
+
+impl From<EnergyTerms> for EnergyReport {
+    fn from(t: EnergyTerms) -> Self {
+        EnergyReport {
+            total: t.potential(),
+            flexural: t.flexural,
+            torsional: t.torsional,
+            extensional: t.extensional,
+            gravitational: t.gravitational,
+            work: t.work,
+            internal: t.internal(),
+        }
+    }
+}
+
+/// A pose of the rod's cross-section frame.
+#[derive(Clone, Debug, Serialize)]
+pub struct PoseReport {
+    /// Arc length.
+    pub s: f64,
+    /// Position (case units).
+    pub position: [f64; 3],
+    /// Rotation matrix `A(φ, θ, ψ)` (rows), columns `ξ, η, ζ`.
+    pub rotation: [[f64; 3]; 3],
+    /// Euler angles `[φ, θ, ψ]` (radians).
+    pub euler_zyz: [f64; 3],
+}
+
+/// Pose at arc length `s` (case units).
+pub fn pose(p: &StaticProblem, a: &[f64], s: f64) -> PoseReport {
+    let m = &p.model;
+    let l = m.rod.length;
+    let t = s / l;
+    let ang = m.angles_at(a, t);
+    PoseReport {
+        s,
+        position: m.position_at(a, t).map(|c| c * l),
+        rotation: rotation(ang[0], ang[1], ang[2]),
+        euler_zyz: ang,
+    }
+}
+
+/// Summary of a static solve or evaluation.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShapeReport {
+    /// Case name.
+    pub case: String,
+    /// `converged`, `iteration_limit`, `infeasible`, `numerical_failure`, or `evaluated`.
+    pub status: String,
+    /// Energy terms (case units).
+    pub energy: EnergyReport,
+    /// Reactions at each constraint (force and moment on the rod, case units).
+    pub reactions: Vec<Reaction>,
+    /// Largest constraint violation (positions in units of `L`).
+    pub max_violation: f64,
+    /// KKT residual (units of `Rf/L`); `null` for an evaluation.
+    pub kkt_residual: Option<f64>,
+    /// Stability verdict; `null` if not computed.
+    pub stable: Option<bool>,
+    /// Smallest reduced-Hessian eigenvalue (units of `Rf/L`).
+    pub min_reduced_eigenvalue: Option<f64>,
+    /// Pose of the `s = L` frame.
+    pub end_pose: PoseReport,
+    /// Poses at the report points.
+    pub points: Vec<PoseReport>,
+    /// Ritz coefficients by field.
+    pub coefficients: serde_json::Value,
+    /// Outer iterations of the multiplier method.
+    pub outer_iterations: Option<usize>,
+    /// Wall-clock seconds.
+    pub timing_s: f64,
+}
+
+/// Coefficients as a JSON object keyed by field, in the case file's `shape` format.
+pub fn coefficients_json(p: &StaticProblem, a: &[f64]) -> serde_json::Value {
+    use crate::layout::Field;
+    let lay = &p.model.layout;
+    let mut m = serde_json::Map::new();
+    for (nm, f) in [("phi", Field::Phi), ("theta", Field::Theta), ("psi", Field::Psi), ("eps", Field::Eps)] {
+        if let Some(c) = lay.field(a, f) {
+            m.insert(nm.into(), serde_json::json!(c));
+        }
+    }
+    serde_json::Value::Object(m)
+}
+
+impl ShapeReport {
+    /// Report of a solved shape.
+    pub fn solved(name: &str, p: &StaticProblem, sol: &StaticSolution, points: &[f64], secs: f64) -> Self {
+        let status = serde_json::to_value(sol.status).ok().and_then(|v| v.as_str().map(String::from));
+        ShapeReport {
+            case: name.into(),
+            status: status.unwrap_or_default(),
+            energy: sol.energy.into(),
+            reactions: sol.reactions.clone(),
+            max_violation: sol.max_violation,
+            kkt_residual: Some(sol.kkt_residual),
+            stable: sol.stable,
+            min_reduced_eigenvalue: sol.min_reduced_eigenvalue,
+            end_pose: pose(p, &sol.a, p.model.rod.length),
+            points: points.iter().map(|&s| pose(p, &sol.a, s)).collect(),
+            coefficients: coefficients_json(p, &sol.a),
+            outer_iterations: Some(sol.outer_iterations),
+            timing_s: secs,
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! Invariants of the model: a straight rod stores no elastic energy, and elastic energy does
+//! not change under a rigid motion of the base.
+
+use dlo_planner::basis::Basis;
+use dlo_planner::energy::Objective;
+use dlo_planner::layout::{Field, Layout};
+use dlo_planner::model::{Discretisation, Model};
+use dlo_planner::rod::{Profile, Rod};
+
+fn rod() -> Rod {
+    Rod {
+        length: 3.0,
+        flexural: Profile::Linear { start: 2.0, end: 1.0 },
+        torsional: Some(Profile::Constant(0.8)),
+        extensional: Some(Profile::Constant(50.0)),
+        weight: Profile::Constant(0.0),
+        radius: 0.01,
+    }
+}
+
+fn model(base: [f64; 3]) -> Model {
+    let layout = Layout { basis: Basis::new(4), spatial: true, extensible: true, free_base: false };
+    Model::new(rod(), layout, Discretisation::default(), base, vec![], &[])
+}
+
+#[test]
+fn straight_rod_has_zero_elastic_energy() {
+    let m = model([0.0; 3]);
+    let lay = m.layout;
+    for (phi, theta, psi) in [(0.0, 0.0, 0.0), (0.4, 1.1, -2.0), (-3.0, 2.5, 7.0)] {
+        let mut a = vec![0.0; m.n()];
+        a[lay.offset(Field::Phi).unwrap()] = phi;
+        a[lay.offset(Field::Theta).unwrap()] = theta;
+        a[lay.offset(Field::Psi).unwrap()] = psi;
+        let t = m.energy(&a, &m.evaluate(&a), Objective::Potential, None);
+        assert!(t.flexural.abs() < 1e-14 && t.torsional.abs() < 1e-14 && t.extensional.abs() < 1e-14, "{t:?}");
+        // And it is straight: |x(L) − x(0)| = L.
+        let s = m.evaluate(&a);
+        let e = s.positions.last().unwrap();
+        assert!(((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() - 1.0).abs() < 1e-13);
+    }
+}
+
+#[test]
+fn elastic_energy_is_invariant_under_rigid_motion_of_the_base() {
+    let m0 = model([0.0; 3]);
+    let m1 = model([0.3, -1.2, 4.0]);
+    let lay = m0.layout;
+    let a: Vec<f64> = (0..m0.n()).map(|i| 0.3 * ((i * 7 % 11) as f64 - 5.0) / 5.0).collect();
+    let elastic = |m: &Model, a: &[f64]| {
+        let t = m.energy(a, &m.evaluate(a), Objective::Potential, None);
+        (t.flexural, t.torsional, t.extensional)
+    };
+    let e0 = elastic(&m0, &a);
+    // Translation.
+    let e1 = elastic(&m1, &a);
+    // Rotation about z by 0.9 rad: φ → φ + 0.9.
+    let mut ar = a.clone();
+    ar[lay.offset(Field::Phi).unwrap()] += 0.9;
+    let e2 = elastic(&m0, &ar);
+    for e in [e1, e2] {
+        assert!((e.0 - e0.0).abs() < 1e-12 * e0.0.abs().max(1.0));
+        assert!((e.1 - e0.1).abs() < 1e-12 * e0.1.abs().max(1.0));
+        assert!((e.2 - e0.2).abs() < 1e-12 * e0.2.abs().max(1.0));
+    }
+    // The shape moved rigidly: end point rotated about z.
+    let (s0, s2) = (m0.evaluate(&a), m0.evaluate(&ar));
+    let (p, q) = (s0.positions.last().unwrap(), s2.positions.last().unwrap());
+    let (c, s) = (0.9f64.cos(), 0.9f64.sin());
+    assert!((q[0] - (c * p[0] - s * p[1])).abs() < 1e-12 && (q[2] - p[2]).abs() < 1e-12);
+}
+
+#[test]
+fn planar_flexure_is_invariant_under_rotation_in_the_plane() {
+    let layout = Layout { basis: Basis::new(4), spatial: false, extensible: false, free_base: false };
+    let m = Model::new(rod(), layout, Discretisation::default(), [0.0; 3], vec![], &[]);
+    let a: Vec<f64> = (0..m.n()).map(|i| 0.2 * (i as f64).cos()).collect();
+    let mut b = a.clone();
+    b[0] += 1.3;
+    let f = |a: &[f64]| m.energy(a, &m.evaluate(a), Objective::Potential, None).flexural;
+    assert!((f(&a) - f(&b)).abs() < 1e-12);
+}
