@@ -471,7 +471,13 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     }
 
     // Points where positions are needed.
-    let mut points: Vec<f64> = (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect();
+    // Sample points become panel boundaries only where obstacles or self-contact need them.
+    let needs_samples = !file.obstacles.is_empty() || file.self_contact;
+    let mut points: Vec<f64> = if needs_samples {
+        (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect()
+    } else {
+        vec![0.0, 1.0]
+    };
     for (i, c) in file.constraints.iter().enumerate() {
         match c {
             ConstraintSpec::Position { s, .. } | ConstraintSpec::Orientation { s, .. } => {
@@ -753,6 +759,9 @@ fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<Ob
             if points.len() < 4 {
                 return Err(v.err(format!("{field}.points"), "a convex hull needs at least 4 points"));
             }
+            if !spans_volume(points) {
+                return Err(v.err(format!("{field}.points"), "points are degenerate (coplanar or collinear): no convex hull"));
+            }
             let pts: Vec<Vector> = points.iter().map(|p| vv(*p)).collect();
             let hull = ConvexPolyhedron::from_convex_hull(&pts)
                 .ok_or_else(|| v.err(format!("{field}.points"), "points are degenerate (coplanar?): no convex hull"))?;
@@ -787,6 +796,18 @@ fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<Ob
             ObstacleShape::HalfSpace(n.map(|c| c / len))
         }
     })
+}
+
+/// True when the points are not all (nearly) coplanar: the covariance has three non-negligible
+/// eigenvalues.
+fn spans_volume(points: &[[f64; 3]]) -> bool {
+    let n = points.len() as f64;
+    let mean: Vec<f64> = (0..3).map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n).collect();
+    let cov = nalgebra::Matrix3::from_fn(|i, j| {
+        points.iter().map(|p| (p[i] - mean[i]) * (p[j] - mean[j])).sum::<f64>() / n
+    });
+    let ev = cov.symmetric_eigenvalues();
+    ev.min() > 1e-12 * ev.max().max(1e-300)
 }
 
 fn coefficients(v: &V, sh: &ShapeSpec, layout: &Layout, base: [f64; 3]) -> Result<Vec<f64>, Error> {
