@@ -11,7 +11,9 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn load(name: &str) -> case::Case {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases").join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("planning_cases")
+        .join(name);
     case::load(&p).expect("shipped case loads")
 }
 
@@ -24,7 +26,10 @@ fn benches(c: &mut Criterion) {
     c.bench_function("planar energy+gradient (10 functions)", |b| {
         b.iter(|| m.objective_and_gradient(black_box(&a), Objective::Internal, &mut shape, &mut g))
     });
-    let no_stab = StaticOptions { stability: false, ..pinned.options };
+    let no_stab = StaticOptions {
+        stability: false,
+        ..pinned.options
+    };
     c.bench_function("planar pinned buckling solve (l = 0.8L)", |b| {
         b.iter(|| {
             let mut p = pinned.problem.clone();
@@ -32,7 +37,10 @@ fn benches(c: &mut Criterion) {
         })
     });
     let twist = load("kinking_twist_2pi_080.json");
-    let opts = StaticOptions { stability: false, ..twist.options };
+    let opts = StaticOptions {
+        stability: false,
+        ..twist.options
+    };
     c.bench_function("3D twisted clamped solve (30 coefficients)", |b| {
         b.iter(|| {
             let mut p = twist.problem.clone();
@@ -40,7 +48,10 @@ fn benches(c: &mut Criterion) {
         })
     });
     let ext = load("extensible_twist_3d.json");
-    let opts = StaticOptions { stability: false, ..ext.options };
+    let opts = StaticOptions {
+        stability: false,
+        ..ext.options
+    };
     c.bench_function("3D extensible twisted solve (40 coefficients)", |b| {
         b.iter(|| {
             let mut p = ext.problem.clone();

@@ -5,7 +5,7 @@
 
 use crate::basis::Basis;
 use crate::constraints::{
-    Bound, Constraint, ObstacleConstraint, OrientationConstraint, PositionConstraint,
+    Angle, Bound, Constraint, ObstacleConstraint, OrientationConstraint, PositionConstraint,
     RelativePositionConstraint, SelfContactConstraint,
 };
 use crate::error::Error;
@@ -17,7 +17,9 @@ use crate::problem::StaticProblem;
 use crate::rod::{Profile, Rod};
 use crate::statics::StaticOptions;
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags};
+use parry3d_f64::shape::{
+    Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags,
+};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -105,7 +107,12 @@ pub struct DiscretisationSpec {
 
 impl Default for DiscretisationSpec {
     fn default() -> Self {
-        DiscretisationSpec { basis_pairs: 4, panels: 16, gauss_points: 4, samples: 32 }
+        DiscretisationSpec {
+            basis_pairs: 4,
+            panels: 16,
+            gauss_points: 4,
+            samples: 32,
+        }
     }
 }
 
@@ -121,7 +128,10 @@ pub struct BaseSpec {
 
 impl Default for BaseSpec {
     fn default() -> Self {
-        BaseSpec { position: [0.0; 3], free: false }
+        BaseSpec {
+            position: [0.0; 3],
+            free: false,
+        }
     }
 }
 
@@ -187,6 +197,8 @@ pub enum ConstraintSpec {
         theta: Option<f64>,
         /// ψ (spatial only).
         psi: Option<f64>,
+        /// φ + ψ (spatial only; instead of φ and ψ, see the README).
+        phi_plus_psi: Option<f64>,
         /// Label in reports.
         name: Option<String>,
     },
@@ -362,15 +374,19 @@ pub struct Case {
 
 /// Reads and validates a case file.
 pub fn load(path: &Path) -> Result<Case, Error> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::Io { path: path.to_path_buf(), source: e })?;
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
     parse(&text, path)
 }
 
 /// Parses and validates case text; `path` names it in errors and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
-    let file: CaseFile = serde_json::from_str(text)
-        .map_err(|e| Error::Parse { path: path.to_path_buf(), message: e.to_string() })?;
+    let file: CaseFile = serde_json::from_str(text).map_err(|e| Error::Parse {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
     build(file, path)
 }
 
@@ -383,18 +399,29 @@ impl V<'_> {
         Error::invalid(self.path, field, msg)
     }
     fn finite(&self, field: &str, v: f64) -> Result<f64, Error> {
-        if v.is_finite() { Ok(v) } else { Err(self.err(field, format!("must be finite, got {v}"))) }
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be finite, got {v}")))
+        }
     }
     fn positive(&self, field: &str, v: f64) -> Result<f64, Error> {
         self.finite(field, v)?;
-        if v > 0.0 { Ok(v) } else { Err(self.err(field, format!("must be positive, got {v}"))) }
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be positive, got {v}")))
+        }
     }
     fn profile_positive(&self, field: &str, p: &Profile) -> Result<(), Error> {
         if !p.is_finite() {
             return Err(self.err(field, "must be finite"));
         }
         if p.min() <= 0.0 {
-            return Err(self.err(field, format!("must be positive along the rod, got minimum {}", p.min())));
+            return Err(self.err(
+                field,
+                format!("must be positive along the rod, got minimum {}", p.min()),
+            ));
         }
         Ok(())
     }
@@ -420,11 +447,17 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     v.profile_positive("rod.flexural_rigidity", &r.flexural_rigidity)?;
     if let Some(p) = &r.torsional_rigidity {
         if file.planar {
-            return Err(v.err("rod.torsional_rigidity", "not used by a planar rod: remove it or set \"planar\": false"));
+            return Err(v.err(
+                "rod.torsional_rigidity",
+                "not used by a planar rod: remove it or set \"planar\": false",
+            ));
         }
         v.profile_positive("rod.torsional_rigidity", p)?;
     } else if !file.planar {
-        return Err(v.err("rod.torsional_rigidity", "required for a spatial rod (\"planar\": false)"));
+        return Err(v.err(
+            "rod.torsional_rigidity",
+            "required for a spatial rod (\"planar\": false)",
+        ));
     }
     if let Some(p) = &r.extensional_rigidity {
         v.profile_positive("rod.extensional_rigidity", p)?;
@@ -440,16 +473,28 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     }
     let d = file.discretisation;
     if !(0..=32).contains(&d.basis_pairs) {
-        return Err(v.err("discretisation.basis_pairs", format!("must be in 0..=32, got {}", d.basis_pairs)));
+        return Err(v.err(
+            "discretisation.basis_pairs",
+            format!("must be in 0..=32, got {}", d.basis_pairs),
+        ));
     }
     if !(1..=2000).contains(&d.panels) {
-        return Err(v.err("discretisation.panels", format!("must be in 1..=2000, got {}", d.panels)));
+        return Err(v.err(
+            "discretisation.panels",
+            format!("must be in 1..=2000, got {}", d.panels),
+        ));
     }
     if !(1..=16).contains(&d.gauss_points) {
-        return Err(v.err("discretisation.gauss_points", format!("must be in 1..=16, got {}", d.gauss_points)));
+        return Err(v.err(
+            "discretisation.gauss_points",
+            format!("must be in 1..=16, got {}", d.gauss_points),
+        ));
     }
     if !(1..=2000).contains(&d.samples) {
-        return Err(v.err("discretisation.samples", format!("must be in 1..=2000, got {}", d.samples)));
+        return Err(v.err(
+            "discretisation.samples",
+            format!("must be in 1..=2000, got {}", d.samples),
+        ));
     }
     let rod = Rod {
         length: l,
@@ -467,14 +512,19 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     };
     let base = v.vec3("base.position", file.base.position)?;
     if file.planar && base[1] != 0.0 {
-        return Err(v.err("base.position[1]", "a planar rod lies in the x–z plane: y must be 0"));
+        return Err(v.err(
+            "base.position[1]",
+            "a planar rod lies in the x–z plane: y must be 0",
+        ));
     }
 
     // Points where positions are needed.
     // Sample points become panel boundaries only where obstacles or self-contact need them.
     let needs_samples = !file.obstacles.is_empty() || file.self_contact;
     let mut points: Vec<f64> = if needs_samples {
-        (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect()
+        (0..=d.samples)
+            .map(|j| j as f64 / d.samples as f64)
+            .collect()
     } else {
         vec![0.0, 1.0]
     };
@@ -496,12 +546,29 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         let force = v.vec3(&format!("forces[{i}].force"), f.force)?;
         let reference = v.vec3(&format!("forces[{i}].reference"), f.reference)?;
         if file.planar && force[1] != 0.0 {
-            return Err(v.err(format!("forces[{i}].force[1]"), "a planar rod cannot take a y force"));
+            return Err(v.err(
+                format!("forces[{i}].force[1]"),
+                "a planar rod cannot take a y force",
+            ));
         }
-        loads.push(PointLoad { t, force: force.map(|c| c / fu), reference: reference.map(|c| c / l) });
+        loads.push(PointLoad {
+            t,
+            force: force.map(|c| c / fu),
+            reference: reference.map(|c| c / l),
+        });
     }
-    let disc = Discretisation { panels: d.panels, gauss_points: d.gauss_points };
-    let model = Model::new(rod.clone(), layout, disc, base.map(|c| c / l), loads, &points);
+    let disc = Discretisation {
+        panels: d.panels,
+        gauss_points: d.gauss_points,
+    };
+    let model = Model::new(
+        rod.clone(),
+        layout,
+        disc,
+        base.map(|c| c / l),
+        loads,
+        &points,
+    );
 
     let mut constraints: Vec<Box<dyn Constraint>> = Vec::new();
     // Fixed points for the reachability check: (t, position, all components fixed).
@@ -526,7 +593,9 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
                         continue;
                     };
                     if !comps.contains(&k) {
-                        return Err(v.err(field(nm), "a planar rod lies in the x–z plane: remove y"));
+                        return Err(
+                            v.err(field(nm), "a planar rod lies in the x–z plane: remove y")
+                        );
                     }
                     match *cs {
                         CoordSpec::Equal(val) => {
@@ -537,7 +606,9 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
                         CoordSpec::Range(RangeSpec { min, max }) => {
                             all_fixed = false;
                             if min.is_none() && max.is_none() {
-                                return Err(v.err(field(nm), "give a number, or \"min\" and/or \"max\""));
+                                return Err(
+                                    v.err(field(nm), "give a number, or \"min\" and/or \"max\"")
+                                );
                             }
                             if let Some(mn) = min {
                                 v.finite(&format!("{}.min", field(nm)), mn)?;
@@ -556,7 +627,10 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
                     }
                 }
                 if rows.is_empty() {
-                    return Err(v.err(format!("constraints[{i}]"), "a position constraint needs at least one of x, y, z"));
+                    return Err(v.err(
+                        format!("constraints[{i}]"),
+                        "a position constraint needs at least one of x, y, z",
+                    ));
                 }
                 if all_fixed {
                     fixed.push((t, fixed_pos));
@@ -567,20 +641,32 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
                     rows,
                 }));
             }
-            ConstraintSpec::RelativePosition { s_a, s_b, x, y, z, name } => {
+            ConstraintSpec::RelativePosition {
+                s_a,
+                s_b,
+                x,
+                y,
+                z,
+                name,
+            } => {
                 let mut rows = Vec::new();
                 let mut vec = [0.0; 3];
                 for (k, (nm, val)) in [("x", x), ("y", y), ("z", z)].into_iter().enumerate() {
                     let Some(val) = val else { continue };
                     if !comps.contains(&k) {
-                        return Err(v.err(field(nm), "a planar rod lies in the x–z plane: remove y"));
+                        return Err(
+                            v.err(field(nm), "a planar rod lies in the x–z plane: remove y")
+                        );
                     }
                     v.finite(&field(nm), *val)?;
                     rows.push((k, val / l));
                     vec[k] = *val;
                 }
                 if rows.is_empty() {
-                    return Err(v.err(format!("constraints[{i}]"), "a relative position needs at least one of x, y, z"));
+                    return Err(v.err(
+                        format!("constraints[{i}]"),
+                        "a relative position needs at least one of x, y, z",
+                    ));
                 }
                 if rows.len() == comps.len() && !layout.extensible {
                     let dist = vec.iter().map(|c| c * c).sum::<f64>().sqrt();
@@ -592,28 +678,52 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
                     }
                 }
                 constraints.push(Box::new(RelativePositionConstraint {
-                    name: name.clone().unwrap_or_else(|| format!("relative position {s_a}→{s_b}")),
+                    name: name
+                        .clone()
+                        .unwrap_or_else(|| format!("relative position {s_a}→{s_b}")),
                     from: model.boundary(s_a / l),
                     to: model.boundary(s_b / l),
                     rows,
                 }));
             }
-            ConstraintSpec::Orientation { s, phi, theta, psi, name } => {
+            ConstraintSpec::Orientation {
+                s,
+                phi,
+                theta,
+                psi,
+                phi_plus_psi,
+                name,
+            } => {
                 let mut rows = Vec::new();
-                for (nm, f, val) in [("phi", Field::Phi, phi), ("theta", Field::Theta, theta), ("psi", Field::Psi, psi)] {
+                if phi_plus_psi.is_some() && (phi.is_some() || psi.is_some()) {
+                    return Err(v.err(
+                        field("phi_plus_psi"),
+                        "give either phi_plus_psi or phi/psi, not both",
+                    ));
+                }
+                for (nm, ang, val) in [
+                    ("phi", Angle::Field(Field::Phi), phi),
+                    ("theta", Angle::Field(Field::Theta), theta),
+                    ("psi", Angle::Field(Field::Psi), psi),
+                    ("phi_plus_psi", Angle::PhiPlusPsi, phi_plus_psi),
+                ] {
                     let Some(val) = val else { continue };
-                    if layout.offset(f).is_none() {
+                    if ang != Angle::Field(Field::Theta) && !layout.spatial {
                         return Err(v.err(field(nm), "a planar rod has only theta"));
                     }
                     v.finite(&field(nm), *val)?;
-                    rows.push((f, *val));
+                    rows.push((ang, *val));
                 }
                 if rows.is_empty() {
-                    return Err(v.err(format!("constraints[{i}]"), "an orientation constraint needs at least one angle"));
+                    return Err(v.err(
+                        format!("constraints[{i}]"),
+                        "an orientation constraint needs at least one angle",
+                    ));
                 }
                 constraints.push(Box::new(OrientationConstraint::new(
                     &model,
-                    name.clone().unwrap_or_else(|| format!("orientation at s={s}")),
+                    name.clone()
+                        .unwrap_or_else(|| format!("orientation at s={s}")),
                     s / l,
                     rows,
                 )));
@@ -635,7 +745,9 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         }
     }
 
-    let samples: Vec<usize> = (0..=d.samples).map(|j| model.boundary(j as f64 / d.samples as f64)).collect();
+    let samples: Vec<usize> = (0..=d.samples)
+        .map(|j| model.boundary(j as f64 / d.samples as f64))
+        .collect();
     let mut obstacles = Vec::new();
     for (i, o) in file.obstacles.iter().enumerate() {
         let f = |x: &str| format!("obstacles[{i}].{x}");
@@ -661,13 +773,22 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         }));
     }
     if file.self_contact {
-        let ts: Vec<f64> = (0..=d.samples).map(|j| j as f64 / d.samples as f64).collect();
-        constraints.push(Box::new(SelfContactConstraint::new(samples.clone(), &ts, 2.0 * radius / l)));
+        let ts: Vec<f64> = (0..=d.samples)
+            .map(|j| j as f64 / d.samples as f64)
+            .collect();
+        constraints.push(Box::new(SelfContactConstraint::new(
+            samples.clone(),
+            &ts,
+            2.0 * radius / l,
+        )));
     }
 
     let (initial, explicit_shape) = match &file.shape {
         Some(sh) => (coefficients(&v, sh, &layout, base.map(|c| c / l))?, true),
-        None => (default_start(&layout, file.solver.perturbation, base.map(|c| c / l)), false),
+        None => (
+            default_start(&layout, file.solver.perturbation, base.map(|c| c / l)),
+            false,
+        ),
     };
     let report_points = match &file.report_points {
         Some(p) => {
@@ -708,7 +829,8 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         ..StaticOptions::default()
     };
     let name = file.name.clone().unwrap_or_else(|| {
-        path.file_stem().map_or("case".into(), |s| s.to_string_lossy().into_owned())
+        path.file_stem()
+            .map_or("case".into(), |s| s.to_string_lossy().into_owned())
     });
     if name.is_empty() || name.contains(['/', '\\']) {
         return Err(v.err("name", "must be non-empty and contain no path separators"));
@@ -729,7 +851,12 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     })
 }
 
-fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<ObstacleShape, Error> {
+fn build_shape(
+    v: &V,
+    s: &ShapeKind,
+    field: &str,
+    case_path: &Path,
+) -> Result<ObstacleShape, Error> {
     let vv = |p: [f64; 3]| Vector::new(p[0], p[1], p[2]);
     Ok(match s {
         ShapeKind::Cuboid { half_extents } => {
@@ -747,7 +874,10 @@ fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<Ob
             let r = v.positive(&format!("{field}.radius"), *radius)?;
             ObstacleShape::Capsule(Capsule::new(vv(*a), vv(*b), r))
         }
-        ShapeKind::Cylinder { half_height, radius } => {
+        ShapeKind::Cylinder {
+            half_height,
+            radius,
+        } => {
             let h = v.positive(&format!("{field}.half_height"), *half_height)?;
             let r = v.positive(&format!("{field}.radius"), *radius)?;
             ObstacleShape::Cylinder(Cylinder::new(h, r))
@@ -757,34 +887,57 @@ fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<Ob
                 v.vec3(&format!("{field}.points[{i}]"), *p)?;
             }
             if points.len() < 4 {
-                return Err(v.err(format!("{field}.points"), "a convex hull needs at least 4 points"));
+                return Err(v.err(
+                    format!("{field}.points"),
+                    "a convex hull needs at least 4 points",
+                ));
             }
             if !spans_volume(points) {
-                return Err(v.err(format!("{field}.points"), "points are degenerate (coplanar or collinear): no convex hull"));
+                return Err(v.err(
+                    format!("{field}.points"),
+                    "points are degenerate (coplanar or collinear): no convex hull",
+                ));
             }
             let pts: Vec<Vector> = points.iter().map(|p| vv(*p)).collect();
-            let hull = ConvexPolyhedron::from_convex_hull(&pts)
-                .ok_or_else(|| v.err(format!("{field}.points"), "points are degenerate (coplanar?): no convex hull"))?;
+            let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
+                v.err(
+                    format!("{field}.points"),
+                    "points are degenerate (coplanar?): no convex hull",
+                )
+            })?;
             ObstacleShape::ConvexHull(Arc::new(hull))
         }
         ShapeKind::TriangleMesh { obj, scale } => {
             let sc = v.positive(&format!("{field}.scale"), *scale)?;
             let full = case_path.parent().unwrap_or(Path::new(".")).join(obj);
             let text = std::fs::read_to_string(&full).map_err(|e| {
-                v.err(format!("{field}.obj"), format!("cannot read {}: {e}", full.display()))
+                v.err(
+                    format!("{field}.obj"),
+                    format!("cannot read {}: {e}", full.display()),
+                )
             })?;
             let (verts, faces) = read_obj(&text)
                 .map_err(|e| v.err(format!("{field}.obj"), format!("{}: {e}", full.display())))?;
             if verts.is_empty() || faces.is_empty() {
-                return Err(v.err(format!("{field}.obj"), format!("{}: the mesh has no triangles", full.display())));
+                return Err(v.err(
+                    format!("{field}.obj"),
+                    format!("{}: the mesh has no triangles", full.display()),
+                ));
             }
             let verts: Vec<Vector> = verts.iter().map(|p| vv(p.map(|c| c * sc))).collect();
             let mesh = TriMesh::with_flags(
                 verts,
                 faces,
-                TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::FIX_INTERNAL_EDGES,
+                TriMeshFlags::ORIENTED
+                    | TriMeshFlags::MERGE_DUPLICATE_VERTICES
+                    | TriMeshFlags::FIX_INTERNAL_EDGES,
             )
-            .map_err(|e| v.err(format!("{field}.obj"), format!("{}: invalid mesh: {e:?}", full.display())))?;
+            .map_err(|e| {
+                v.err(
+                    format!("{field}.obj"),
+                    format!("{}: invalid mesh: {e:?}", full.display()),
+                )
+            })?;
             ObstacleShape::TriMesh(Arc::new(mesh))
         }
         ShapeKind::HalfSpace { normal } => {
@@ -802,9 +955,15 @@ fn build_shape(v: &V, s: &ShapeKind, field: &str, case_path: &Path) -> Result<Ob
 /// eigenvalues.
 fn spans_volume(points: &[[f64; 3]]) -> bool {
     let n = points.len() as f64;
-    let mean: Vec<f64> = (0..3).map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n).collect();
+    let mean: Vec<f64> = (0..3)
+        .map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n)
+        .collect();
     let cov = nalgebra::Matrix3::from_fn(|i, j| {
-        points.iter().map(|p| (p[i] - mean[i]) * (p[j] - mean[j])).sum::<f64>() / n
+        points
+            .iter()
+            .map(|p| (p[i] - mean[i]) * (p[j] - mean[j]))
+            .sum::<f64>()
+            / n
     });
     let ev = cov.symmetric_eigenvalues();
     ev.min() > 1e-12 * ev.max().max(1e-300)
@@ -822,10 +981,23 @@ fn coefficients(v: &V, sh: &ShapeSpec, layout: &Layout, base: [f64; 3]) -> Resul
         let Some(vals) = vals else { continue };
         let field = format!("shape.{nm}");
         let off = layout.offset(f).ok_or_else(|| {
-            v.err(&field, if f == Field::Eps { "the rod is inextensible (no extensional_rigidity)" } else { "a planar rod has only theta (and eps)" })
+            v.err(
+                &field,
+                if f == Field::Eps {
+                    "the rod is inextensible (no extensional_rigidity)"
+                } else {
+                    "a planar rod has only theta (and eps)"
+                },
+            )
         })?;
         if vals.len() != nb {
-            return Err(v.err(&field, format!("expected {nb} coefficients (2 + 2·basis_pairs), got {}", vals.len())));
+            return Err(v.err(
+                &field,
+                format!(
+                    "expected {nb} coefficients (2 + 2·basis_pairs), got {}",
+                    vals.len()
+                ),
+            ));
         }
         for (i, c) in vals.iter().enumerate() {
             a[off + i] = v.finite(&format!("{field}[{i}]"), *c)?;

@@ -6,9 +6,9 @@
 //! - extension `½∫ Re ε²` (eq. 10)
 //! - gravity  `∫ D x ds` (eq. 11), evaluated by parts as `x(0)·∫D + ∫ (1+ε) ζₓ(t) ∫ₜᴸ D`.
 
+use crate::kinematics::Shape;
 use crate::layout::Field;
 use crate::model::Model;
-use crate::kinematics::Shape;
 use serde::Serialize;
 
 /// The energy terms of one shape.
@@ -90,7 +90,9 @@ impl Model {
                 t.extensional += 0.5 * we * eps * eps;
             }
             t.gravitational += wg * one * st * cp;
-            let Some(g) = grad.as_deref_mut() else { continue };
+            let Some(g) = grad.as_deref_mut() else {
+                continue;
+            };
             let (e, de) = (self.e_at(q), self.de_at(q));
             // d/dθ (value) and d/dθ' terms
             let mut g_th = wg * one * ct * cp;
@@ -128,7 +130,9 @@ impl Model {
             let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
             for (ld, &b) in self.loads.iter().zip(&self.load_boundary) {
                 let x = shape.positions[b];
-                t.work += (0..3).map(|k| ld.force[k] * (x[k] - ld.reference[k])).sum::<f64>();
+                t.work += (0..3)
+                    .map(|k| ld.force[k] * (x[k] - ld.reference[k]))
+                    .sum::<f64>();
                 for k in 0..3 {
                     v[b][k] -= ld.force[k];
                 }

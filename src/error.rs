@@ -36,7 +36,15 @@ pub enum Error {
 
 impl Error {
     /// Shorthand for [`Error::Invalid`].
-    pub fn invalid(path: &std::path::Path, field: impl Into<String>, message: impl Into<String>) -> Self {
-        Error::Invalid { path: path.to_path_buf(), field: field.into(), message: message.into() }
+    pub fn invalid(
+        path: &std::path::Path,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Invalid {
+            path: path.to_path_buf(),
+            field: field.into(),
+            message: message.into(),
+        }
     }
 }

@@ -183,13 +183,19 @@ impl Model {
 
     /// Strain `ε` at `t` (zero for inextensible rods).
     pub fn strain_at(&self, a: &[f64], t: f64) -> f64 {
-        self.layout.field(a, Field::Eps).map_or(0.0, |c| self.layout.basis.eval(c, t))
+        self.layout
+            .field(a, Field::Eps)
+            .map_or(0.0, |c| self.layout.basis.eval(c, t))
     }
 
     /// Position at an arbitrary `t` (dimensionless), by Gauss quadrature of eq. (6) on `[0, t]`.
     pub fn position_at(&self, a: &[f64], t: f64) -> [f64; 3] {
         let shape = self.evaluate(a);
-        let j = self.mesh.boundaries.partition_point(|&b| b <= t).saturating_sub(1);
+        let j = self
+            .mesh
+            .boundaries
+            .partition_point(|&b| b <= t)
+            .saturating_sub(1);
         let j = j.min(self.mesh.panels() - 1);
         let mut x = shape.positions[j];
         let t0 = self.mesh.boundaries[j];

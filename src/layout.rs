@@ -45,7 +45,9 @@ impl Layout {
             Field::Theta => Some(0),
             Field::Phi => self.spatial.then_some(nb),
             Field::Psi => self.spatial.then_some(2 * nb),
-            Field::Eps => self.extensible.then_some(if self.spatial { 3 * nb } else { nb }),
+            Field::Eps => self
+                .extensible
+                .then_some(if self.spatial { 3 * nb } else { nb }),
         }
     }
 
@@ -73,7 +75,12 @@ impl Layout {
 
     /// Total number of unknowns.
     pub fn len(&self) -> usize {
-        self.n_fields() + if self.free_base { self.components().len() } else { 0 }
+        self.n_fields()
+            + if self.free_base {
+                self.components().len()
+            } else {
+                0
+            }
     }
 
     /// Always false: every layout has `θ`.

@@ -17,7 +17,11 @@ const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_NOT_CONVERGED: u8 = 3;
 
 #[derive(Parser)]
-#[command(name = "dlo", version, about = "Static shapes and deformation paths of deformable linear objects (Wakamatsu & Hirai 2004)")]
+#[command(
+    name = "dlo",
+    version,
+    about = "Static shapes and deformation paths of deformable linear objects (Wakamatsu & Hirai 2004)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -94,7 +98,10 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
         Err(code) => return code,
     };
     if !c.explicit_shape {
-        eprintln!("error: {}: field `shape`: `dlo energy` needs explicit coefficients", path.display());
+        eprintln!(
+            "error: {}: field `shape`: `dlo energy` needs explicit coefficients",
+            path.display()
+        );
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     let t0 = Instant::now();
@@ -120,38 +127,59 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// Writes to stdout, ignoring a closed pipe (e.g. `dlo shape … | head`).
+fn emit(text: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
+
 fn print_report(r: &ShapeReport, json: bool) {
+    use std::fmt::Write;
     if json {
-        println!("{}", serde_json::to_string_pretty(r).expect("report serialises"));
+        emit(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(r).expect("report serialises")
+        ));
         return;
     }
-    println!("case {}: {}", r.case, r.status);
+    let mut o = String::new();
+    let _ = writeln!(o, "case {}: {}", r.case, r.status);
     let e = &r.energy;
-    println!(
+    let _ = writeln!(
+        o,
         "  energy U = {:.6e}  (flexural {:.6e}, torsional {:.6e}, extensional {:.6e}, gravitational {:.6e}; work {:.6e})",
         e.total, e.flexural, e.torsional, e.extensional, e.gravitational, e.work
     );
-    print!("  max violation {:.2e}", r.max_violation);
+    let _ = write!(o, "  max violation {:.2e}", r.max_violation);
     if let Some(k) = r.kkt_residual {
-        print!(", KKT residual {k:.2e}");
+        let _ = write!(o, ", KKT residual {k:.2e}");
     }
-    match r.stable {
-        Some(true) => print!(", stable"),
-        Some(false) => print!(", UNSTABLE"),
-        None => {}
-    }
-    println!();
+    o.push_str(match r.stable {
+        Some(true) => ", stable",
+        Some(false) => ", UNSTABLE",
+        None => "",
+    });
+    let _ = writeln!(o);
     for re in &r.reactions {
-        println!(
+        let _ = writeln!(
+            o,
             "  reaction {:24} force [{:+.6e}, {:+.6e}, {:+.6e}]  moment [{:+.6e}, {:+.6e}, {:+.6e}]",
-            re.constraint, re.force[0], re.force[1], re.force[2], re.moment[0], re.moment[1], re.moment[2]
+            re.constraint,
+            re.force[0],
+            re.force[1],
+            re.force[2],
+            re.moment[0],
+            re.moment[1],
+            re.moment[2]
         );
     }
     for p in &r.points {
-        println!(
+        let _ = writeln!(
+            o,
             "  s = {:10.4}: x = [{:+.6}, {:+.6}, {:+.6}]",
             p.s, p.position[0], p.position[1], p.position[2]
         );
     }
-    println!("  time {:.3} ms", r.timing_s * 1e3);
+    let _ = writeln!(o, "  time {:.3} ms", r.timing_s * 1e3);
+    emit(&o);
 }

@@ -32,7 +32,10 @@ pub struct Discretisation {
 
 impl Default for Discretisation {
     fn default() -> Self {
-        Discretisation { panels: 16, gauss_points: 4 }
+        Discretisation {
+            panels: 16,
+            gauss_points: 4,
+        }
     }
 }
 

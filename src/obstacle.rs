@@ -94,7 +94,11 @@ impl Obstacle {
             return (0.0, self.fallback_normal(p));
         }
         let n = diff / dist;
-        if proj.is_inside { (-dist, [-n.x, -n.y, -n.z]) } else { (dist, [n.x, n.y, n.z]) }
+        if proj.is_inside {
+            (-dist, [-n.x, -n.y, -n.z])
+        } else {
+            (dist, [n.x, n.y, n.z])
+        }
     }
 
     fn fallback_normal(&self, p: [f64; 3]) -> [f64; 3] {

@@ -79,9 +79,16 @@ impl Nlp for StaticProblem {
     fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
         self.model.evaluate_into(x, &mut self.shape);
         self.grad_f.iter_mut().for_each(|g| *g = 0.0);
-        self.terms = self.model.energy(x, &self.shape, self.objective, Some(&mut self.grad_f));
+        self.terms = self
+            .model
+            .energy(x, &self.shape, self.objective, Some(&mut self.grad_f));
         for (k, con) in self.constraints.iter().enumerate() {
-            con.values(&self.model, x, &self.shape, &mut c[self.offsets[k]..self.offsets[k + 1]]);
+            con.values(
+                &self.model,
+                x,
+                &self.shape,
+                &mut c[self.offsets[k]..self.offsets[k + 1]],
+            );
         }
         match self.objective {
             Objective::Internal => self.terms.internal(),

@@ -31,7 +31,11 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
         }
         x[i] = -z;
         x[n - 1 - i] = z;
-        let wi = if n == 1 { 2.0 } else { 2.0 / ((1.0 - z * z) * dp * dp) };
+        let wi = if n == 1 {
+            2.0
+        } else {
+            2.0 / ((1.0 - z * z) * dp * dp)
+        };
         w[i] = wi;
         w[n - 1 - i] = wi;
     }
@@ -72,7 +76,12 @@ impl Mesh {
             }
             panel_start.push(nodes.len());
         }
-        Mesh { boundaries: b, nodes, weights, panel_start }
+        Mesh {
+            boundaries: b,
+            nodes,
+            weights,
+            panel_start,
+        }
     }
 
     /// Index of the boundary closest to `t`.
@@ -102,7 +111,11 @@ mod tests {
             let (x, w) = gauss_legendre(n);
             for deg in 0..2 * n {
                 let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
-                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
                 assert!((q - exact).abs() < 1e-13, "n={n} deg={deg} {q} {exact}");
             }
         }

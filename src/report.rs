@@ -102,7 +102,12 @@ pub fn coefficients_json(p: &StaticProblem, a: &[f64]) -> serde_json::Value {
     use crate::layout::Field;
     let lay = &p.model.layout;
     let mut m = serde_json::Map::new();
-    for (nm, f) in [("phi", Field::Phi), ("theta", Field::Theta), ("psi", Field::Psi), ("eps", Field::Eps)] {
+    for (nm, f) in [
+        ("phi", Field::Phi),
+        ("theta", Field::Theta),
+        ("psi", Field::Psi),
+        ("eps", Field::Eps),
+    ] {
         if let Some(c) = lay.field(a, f) {
             m.insert(nm.into(), serde_json::json!(c));
         }
@@ -112,8 +117,16 @@ pub fn coefficients_json(p: &StaticProblem, a: &[f64]) -> serde_json::Value {
 
 impl ShapeReport {
     /// Report of a solved shape.
-    pub fn solved(name: &str, p: &StaticProblem, sol: &StaticSolution, points: &[f64], secs: f64) -> Self {
-        let status = serde_json::to_value(sol.status).ok().and_then(|v| v.as_str().map(String::from));
+    pub fn solved(
+        name: &str,
+        p: &StaticProblem,
+        sol: &StaticSolution,
+        points: &[f64],
+        secs: f64,
+    ) -> Self {
+        let status = serde_json::to_value(sol.status)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from));
         ShapeReport {
             case: name.into(),
             status: status.unwrap_or_default(),

@@ -95,7 +95,8 @@ impl Rod {
 
     /// The paper's `ρe = Re L²/Rf` (mean values).
     pub fn rho_e(&self) -> Option<f64> {
-        self.extensional.map(|p| p.mean() * self.length.powi(2) / self.rf_ref())
+        self.extensional
+            .map(|p| p.mean() * self.length.powi(2) / self.rf_ref())
     }
 
     /// The paper's `ρg = D L³/Rf` (mean values).

@@ -1,6 +1,7 @@
 //! Static shapes (paper §4): the multiplier method around BFGS on a [`StaticProblem`], with the
 //! multipliers turned into reaction forces and moments, and a stability verdict.
 
+use crate::constraints::Angle;
 use crate::energy::EnergyTerms;
 use crate::kinematics::rotation;
 use crate::layout::Field;
@@ -26,7 +27,11 @@ pub struct StaticOptions {
 
 impl Default for StaticOptions {
     fn default() -> Self {
-        StaticOptions { al: AlOptions::default(), stability: true, stability_tol: 1e-6 }
+        StaticOptions {
+            al: AlOptions::default(),
+            stability: true,
+            stability_tol: 1e-6,
+        }
     }
 }
 
@@ -136,6 +141,7 @@ fn finish(
 /// Converts multipliers into reactions (see [`Reaction`]).
 pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> {
     use crate::constraints::*;
+
     let m = &p.model;
     let fu = m.rod.force_unit();
     let mu = m.rod.energy_unit();
@@ -154,7 +160,11 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
         if let Some(pc) = downcast::<PositionConstraint>(con.as_ref()) {
             r.s = Some(m.mesh.boundaries[pc.boundary] * l);
             for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
-                let sign = if matches!(b, Bound::AtLeast(_)) { 1.0 } else { -1.0 };
+                let sign = if matches!(b, Bound::AtLeast(_)) {
+                    1.0
+                } else {
+                    -1.0
+                };
                 r.force[comp] += sign * li * fu;
             }
         } else if let Some(rc) = downcast::<RelativePositionConstraint>(con.as_ref()) {
@@ -164,24 +174,21 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
             }
         } else if let Some(oc) = downcast::<OrientationConstraint>(con.as_ref()) {
             r.s = Some(oc.t * l);
-            for (&li, &(f, _)) in lam.iter().zip(&oc.rows) {
-                let idx = match f {
-                    Field::Phi => 0,
-                    Field::Theta => 1,
-                    Field::Psi => 2,
-                    Field::Eps => continue,
-                };
-                r.angle_torques[idx] = -li * mu;
-            }
+            // Generalized torques conjugate to each prescribed angle row; a φ+ψ row acts on
+            // both (its torque is about z = ζ where θ = 0).
             let mut torques = [0.0; 3];
-            for (&li, &(f, _)) in lam.iter().zip(&oc.rows) {
-                match f {
-                    Field::Phi => torques[0] = -li,
-                    Field::Theta => torques[1] = -li,
-                    Field::Psi => torques[2] = -li,
-                    Field::Eps => {}
+            for (&li, &(ang, _)) in lam.iter().zip(&oc.rows) {
+                for &(f, w) in ang.terms() {
+                    match f {
+                        Field::Phi if ang == Angle::PhiPlusPsi => {}
+                        Field::Phi => torques[0] -= li * w,
+                        Field::Theta => torques[1] -= li * w,
+                        Field::Psi => torques[2] -= li * w,
+                        Field::Eps => {}
+                    }
                 }
             }
+            r.angle_torques = torques.map(|v| v * mu);
             r.moment = least_squares_moment(m, a, oc, torques).map(|v| v * mu);
         } else if let Some(ob) = downcast::<ObstacleConstraint>(con.as_ref()) {
             let shape = m.evaluate(a);
@@ -222,11 +229,11 @@ fn least_squares_moment(
     let rows: Vec<usize> = oc
         .rows
         .iter()
-        .filter_map(|(f, _)| match f {
-            Field::Phi => Some(0),
-            Field::Theta => Some(1),
-            Field::Psi => Some(2),
-            Field::Eps => None,
+        .filter_map(|(ang, _)| match ang {
+            Angle::Field(Field::Phi) => Some(0),
+            Angle::Field(Field::Theta) => Some(1),
+            Angle::Field(Field::Psi) | Angle::PhiPlusPsi => Some(2),
+            Angle::Field(Field::Eps) => None,
         })
         .collect();
     if rows.is_empty() {
@@ -254,5 +261,10 @@ pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> (EnergyTerms, f64, Ve
     let zero = vec![0.0; p.m()];
     let (lambda, kkt) = least_squares_multipliers(p, a, &c, &zero, 1e-7)
         .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
-    (terms.scaled(p.model.rod.energy_unit()), viol, reactions(p, a, &lambda), kkt)
+    (
+        terms.scaled(p.model.rod.energy_unit()),
+        viol,
+        reactions(p, a, &lambda),
+        kkt,
+    )
 }

@@ -4,7 +4,10 @@
 use std::process::Command;
 
 fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dlo")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(args)
+        .output()
+        .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -21,39 +24,207 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
         ("not json", "this is not json".into(), "line 1 column"),
         ("empty file", "".into(), "EOF"),
         ("missing rod", c(r#""planar": true"#), "missing field `rod`"),
-        ("missing length", c(r#""rod": {"flexural_rigidity": 1.0}"#), "missing field `length`"),
-        ("unknown top-level field", c(&format!(r#"{GOOD_ROD}, "colour": "red""#)), "unknown field `colour`"),
-        ("unknown rod field", c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "stiffness": 2}"#), "unknown field `stiffness`"),
-        ("wrong type", c(r#""rod": {"length": "long", "flexural_rigidity": 1.0}"#), "invalid type"),
-        ("negative length", c(r#""rod": {"length": -1.0, "flexural_rigidity": 1.0}"#), "rod.length"),
-        ("zero rigidity", c(r#""rod": {"length": 1.0, "flexural_rigidity": 0.0}"#), "rod.flexural_rigidity"),
-        ("negative linear rigidity", c(r#""rod": {"length": 1.0, "flexural_rigidity": {"start": 1.0, "end": -0.5}}"#), "rod.flexural_rigidity"),
-        ("NaN literal", c(r#""rod": {"length": NaN, "flexural_rigidity": 1.0}"#), "expected value"),
-        ("overflowing number", c(r#""rod": {"length": 1e999, "flexural_rigidity": 1.0}"#), "number out of range"),
-        ("torsion on planar rod", c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.7}"#), "rod.torsional_rigidity"),
-        ("spatial rod without torsion", c(&format!(r#"{GOOD_ROD}, "planar": false"#)), "rod.torsional_rigidity"),
-        ("negative weight", c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "weight_per_length": -2.0}"#), "rod.weight_per_length"),
-        ("radius too large", c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "radius": 0.7}"#), "rod.radius"),
-        ("s beyond length", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 150.0, "x": 0.0}}]"#)), "constraints[0].s"),
-        ("unknown constraint type", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "glue", "s": 1.0}}]"#)), "unknown variant `glue`"),
-        ("y on planar rod", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0, "y": 1.0}}]"#)), "constraints[0].y"),
-        ("empty position", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0}}]"#)), "constraints[0]"),
-        ("phi on planar rod", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "orientation", "s": 0.0, "phi": 0.0}}]"#)), "constraints[0].phi"),
-        ("unreachable end distance", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0, "x": 0.0, "z": 120.0}}]"#)), "unreachable"),
-        ("unreachable relative position", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "relative_position", "s_a": 10.0, "s_b": 30.0, "x": 15.0, "z": 15.0}}]"#)), "unreachable"),
-        ("min above max", c(&format!(r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 0.0, "z": {{"min": 2.0, "max": 1.0}}}}]"#)), "exceeds max"),
-        ("basis too large", c(&format!(r#"{GOOD_ROD}, "discretisation": {{"basis_pairs": 99}}"#)), "discretisation.basis_pairs"),
-        ("zero panels", c(&format!(r#"{GOOD_ROD}, "discretisation": {{"panels": 0}}"#)), "discretisation.panels"),
-        ("bad ball radius", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "ball", "radius": -1.0}}}}]"#)), "obstacles[0].shape.radius"),
-        ("unknown shape", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "torus", "radius": 1.0}}}}]"#)), "unknown variant `torus`"),
-        ("zero half-space normal", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "half_space", "normal": [0, 0, 0]}}}}]"#)), "obstacles[0].shape.normal"),
-        ("degenerate hull", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "convex_hull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}}}}]"#)), "obstacles[0].shape.points"),
-        ("missing mesh file", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "triangle_mesh", "obj": "nope.obj"}}}}]"#)), "obstacles[0].shape.obj"),
-        ("empty mesh", c(&format!(r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "triangle_mesh", "obj": "empty.obj"}}}}]"#)), "no triangles"),
-        ("wrong coefficient count", c(&format!(r#"{GOOD_ROD}, "shape": {{"theta": [0.0, 1.0]}}"#)), "shape.theta"),
-        ("eps on inextensible rod", c(&format!(r#"{GOOD_ROD}, "shape": {{"eps": [0,0,0,0,0,0,0,0,0,0]}}"#)), "shape.eps"),
-        ("negative tolerance", c(&format!(r#"{GOOD_ROD}, "solver": {{"feasibility_tol": -1.0}}"#)), "solver.feasibility_tol"),
-        ("force on y of planar rod", c(&format!(r#"{GOOD_ROD}, "forces": [{{"s": 50.0, "force": [0.0, 1.0, 0.0]}}]"#)), "forces[0].force[1]"),
+        (
+            "missing length",
+            c(r#""rod": {"flexural_rigidity": 1.0}"#),
+            "missing field `length`",
+        ),
+        (
+            "unknown top-level field",
+            c(&format!(r#"{GOOD_ROD}, "colour": "red""#)),
+            "unknown field `colour`",
+        ),
+        (
+            "unknown rod field",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "stiffness": 2}"#),
+            "unknown field `stiffness`",
+        ),
+        (
+            "wrong type",
+            c(r#""rod": {"length": "long", "flexural_rigidity": 1.0}"#),
+            "invalid type",
+        ),
+        (
+            "negative length",
+            c(r#""rod": {"length": -1.0, "flexural_rigidity": 1.0}"#),
+            "rod.length",
+        ),
+        (
+            "zero rigidity",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": 0.0}"#),
+            "rod.flexural_rigidity",
+        ),
+        (
+            "negative linear rigidity",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": {"start": 1.0, "end": -0.5}}"#),
+            "rod.flexural_rigidity",
+        ),
+        (
+            "NaN literal",
+            c(r#""rod": {"length": NaN, "flexural_rigidity": 1.0}"#),
+            "expected value",
+        ),
+        (
+            "overflowing number",
+            c(r#""rod": {"length": 1e999, "flexural_rigidity": 1.0}"#),
+            "number out of range",
+        ),
+        (
+            "torsion on planar rod",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.7}"#),
+            "rod.torsional_rigidity",
+        ),
+        (
+            "spatial rod without torsion",
+            c(&format!(r#"{GOOD_ROD}, "planar": false"#)),
+            "rod.torsional_rigidity",
+        ),
+        (
+            "negative weight",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "weight_per_length": -2.0}"#),
+            "rod.weight_per_length",
+        ),
+        (
+            "radius too large",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "radius": 0.7}"#),
+            "rod.radius",
+        ),
+        (
+            "s beyond length",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 150.0, "x": 0.0}}]"#
+            )),
+            "constraints[0].s",
+        ),
+        (
+            "unknown constraint type",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "glue", "s": 1.0}}]"#
+            )),
+            "unknown variant `glue`",
+        ),
+        (
+            "y on planar rod",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0, "y": 1.0}}]"#
+            )),
+            "constraints[0].y",
+        ),
+        (
+            "empty position",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0}}]"#
+            )),
+            "constraints[0]",
+        ),
+        (
+            "phi on planar rod",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "orientation", "s": 0.0, "phi": 0.0}}]"#
+            )),
+            "constraints[0].phi",
+        ),
+        (
+            "unreachable end distance",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 100.0, "x": 0.0, "z": 120.0}}]"#
+            )),
+            "unreachable",
+        ),
+        (
+            "unreachable relative position",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "relative_position", "s_a": 10.0, "s_b": 30.0, "x": 15.0, "z": 15.0}}]"#
+            )),
+            "unreachable",
+        ),
+        (
+            "min above max",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 0.0, "z": {{"min": 2.0, "max": 1.0}}}}]"#
+            )),
+            "exceeds max",
+        ),
+        (
+            "basis too large",
+            c(&format!(
+                r#"{GOOD_ROD}, "discretisation": {{"basis_pairs": 99}}"#
+            )),
+            "discretisation.basis_pairs",
+        ),
+        (
+            "zero panels",
+            c(&format!(r#"{GOOD_ROD}, "discretisation": {{"panels": 0}}"#)),
+            "discretisation.panels",
+        ),
+        (
+            "bad ball radius",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "ball", "radius": -1.0}}}}]"#
+            )),
+            "obstacles[0].shape.radius",
+        ),
+        (
+            "unknown shape",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "torus", "radius": 1.0}}}}]"#
+            )),
+            "unknown variant `torus`",
+        ),
+        (
+            "zero half-space normal",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "half_space", "normal": [0, 0, 0]}}}}]"#
+            )),
+            "obstacles[0].shape.normal",
+        ),
+        (
+            "degenerate hull",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "convex_hull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}}}}]"#
+            )),
+            "obstacles[0].shape.points",
+        ),
+        (
+            "missing mesh file",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "triangle_mesh", "obj": "nope.obj"}}}}]"#
+            )),
+            "obstacles[0].shape.obj",
+        ),
+        (
+            "empty mesh",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "triangle_mesh", "obj": "empty.obj"}}}}]"#
+            )),
+            "no triangles",
+        ),
+        (
+            "wrong coefficient count",
+            c(&format!(r#"{GOOD_ROD}, "shape": {{"theta": [0.0, 1.0]}}"#)),
+            "shape.theta",
+        ),
+        (
+            "eps on inextensible rod",
+            c(&format!(
+                r#"{GOOD_ROD}, "shape": {{"eps": [0,0,0,0,0,0,0,0,0,0]}}"#
+            )),
+            "shape.eps",
+        ),
+        (
+            "negative tolerance",
+            c(&format!(
+                r#"{GOOD_ROD}, "solver": {{"feasibility_tol": -1.0}}"#
+            )),
+            "solver.feasibility_tol",
+        ),
+        (
+            "force on y of planar rod",
+            c(&format!(
+                r#"{GOOD_ROD}, "forces": [{{"s": 50.0, "force": [0.0, 1.0, 0.0]}}]"#
+            )),
+            "forces[0].force[1]",
+        ),
     ]
 }
 
@@ -70,8 +241,14 @@ fn malformed_cases_give_exit_code_2_and_name_the_problem() {
         for cmd in ["shape", "energy"] {
             let (code, stdout, stderr) = run(&[cmd, path.to_str().unwrap(), "--json"]);
             assert_eq!(code, 2, "{label}: exit code {code}, stderr: {stderr}");
-            assert!(stderr.contains(&format!("bad_{i}.json")), "{label}: file not named: {stderr}");
-            assert!(stderr.contains(needle), "{label}: expected '{needle}' in: {stderr}");
+            assert!(
+                stderr.contains(&format!("bad_{i}.json")),
+                "{label}: file not named: {stderr}"
+            );
+            assert!(
+                stderr.contains(needle),
+                "{label}: expected '{needle}' in: {stderr}"
+            );
             assert!(!stderr.contains("panicked"), "{label}: panic: {stderr}");
             assert!(stdout.is_empty(), "{label}: half-written output: {stdout}");
         }
@@ -90,20 +267,47 @@ fn missing_file_and_bad_usage_are_bad_input() {
 
 #[test]
 fn energy_without_explicit_shape_is_bad_input() {
-    let (code, _, stderr) = run(&["energy", concat!(env!("CARGO_MANIFEST_DIR"), "/planning_cases/pinned_buckling_095.json")]);
+    let (code, _, stderr) = run(&[
+        "energy",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/planning_cases/pinned_buckling_095.json"
+        ),
+    ]);
     assert_eq!(code, 2);
     assert!(stderr.contains("`shape`"));
 }
 
 #[test]
 fn shipped_pinned_case_prints_documented_json() {
-    let (code, stdout, _) = run(&["shape", concat!(env!("CARGO_MANIFEST_DIR"), "/planning_cases/pinned_buckling_080.json"), "--json"]);
+    let (code, stdout, _) = run(&[
+        "shape",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/planning_cases/pinned_buckling_080.json"
+        ),
+        "--json",
+    ]);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    for key in ["status", "energy", "reactions", "max_violation", "stable", "end_pose", "timing_s"] {
+    for key in [
+        "status",
+        "energy",
+        "reactions",
+        "max_violation",
+        "stable",
+        "end_pose",
+        "timing_s",
+    ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
-    for key in ["total", "flexural", "torsional", "extensional", "gravitational"] {
+    for key in [
+        "total",
+        "flexural",
+        "torsional",
+        "extensional",
+        "gravitational",
+    ] {
         assert!(v["energy"][key].is_number(), "missing energy.{key}");
     }
     assert_eq!(v["status"], "converged");

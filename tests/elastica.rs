@@ -19,7 +19,15 @@ fn pinned_reaction_matches_elastica_at_default_basis() {
     for ratio in [0.95, 0.80, 0.60] {
         let exact = pinned_elastica_load(ratio) / 100.0_f64.powi(2);
         let (p, sol) = buckle(ratio, 4);
-        eprintln!("l/L={ratio}: P={p:.6e} exact={exact:.6e} rel={:.2e} status={:?} viol={:.1e} kkt={:.1e} stable={:?} evals={}", (p-exact).abs()/exact, sol.status, sol.max_violation, sol.kkt_residual, sol.stable, sol.evaluations);
+        eprintln!(
+            "l/L={ratio}: P={p:.6e} exact={exact:.6e} rel={:.2e} status={:?} viol={:.1e} kkt={:.1e} stable={:?} evals={}",
+            (p - exact).abs() / exact,
+            sol.status,
+            sol.max_violation,
+            sol.kkt_residual,
+            sol.stable,
+            sol.evaluations
+        );
         assert!((p - exact).abs() / exact < 1e-3);
     }
 }
@@ -54,7 +62,11 @@ fn clamped_load_is_four_times_pinned() {
     let model = p0.model.clone();
     let c: Vec<Box<dyn Constraint>> = vec![
         clamp(&model, 0.0),
-        Box::new(PositionConstraint { name: "end".into(), boundary: model.boundary(1.0), rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(0.6))] }),
+        Box::new(PositionConstraint {
+            name: "end".into(),
+            boundary: model.boundary(1.0),
+            rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(0.6))],
+        }),
         clamp(&model, 1.0),
     ];
     let mut p = dlo_planner::problem::StaticProblem::new(model, c);

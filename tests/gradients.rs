@@ -21,7 +21,10 @@ use std::sync::Arc;
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
 }
@@ -29,29 +32,62 @@ impl Lcg {
 fn rod(spatial: bool, extensible: bool) -> Rod {
     Rod {
         length: 2.0,
-        flexural: Profile::Linear { start: 1.0, end: 0.5 },
-        torsional: spatial.then_some(Profile::Linear { start: 0.7, end: 0.9 }),
+        flexural: Profile::Linear {
+            start: 1.0,
+            end: 0.5,
+        },
+        torsional: spatial.then_some(Profile::Linear {
+            start: 0.7,
+            end: 0.9,
+        }),
         extensional: extensible.then_some(Profile::Constant(80.0)),
-        weight: Profile::Linear { start: 3.0, end: 1.0 },
+        weight: Profile::Linear {
+            start: 3.0,
+            end: 1.0,
+        },
         radius: 0.02,
     }
 }
 
 fn model(spatial: bool, extensible: bool, free_base: bool) -> Model {
-    let layout = Layout { basis: Basis::new(3), spatial, extensible, free_base };
-    let loads = vec![PointLoad { t: 0.37, force: [0.3, if spatial { -0.2 } else { 0.0 }, 0.5], reference: [0.1, 0.0, 0.2] }];
+    let layout = Layout {
+        basis: Basis::new(3),
+        spatial,
+        extensible,
+        free_base,
+    };
+    let loads = vec![PointLoad {
+        t: 0.37,
+        force: [0.3, if spatial { -0.2 } else { 0.0 }, 0.5],
+        reference: [0.1, 0.0, 0.2],
+    }];
     let samples: Vec<f64> = (0..=16).map(|j| j as f64 / 16.0).collect();
     let mut pts = samples.clone();
     pts.extend([0.25, 0.6, 1.0]);
-    Model::new(rod(spatial, extensible), layout, Discretisation { panels: 8, gauss_points: 4 }, [0.05, 0.0, -0.1], loads, &pts)
+    Model::new(
+        rod(spatial, extensible),
+        layout,
+        Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        },
+        [0.05, 0.0, -0.1],
+        loads,
+        &pts,
+    )
 }
 
 fn random_a(m: &Model, rng: &mut Lcg, scale: f64) -> Vec<f64> {
     (0..m.n()).map(|_| scale * rng.next()).collect()
 }
 
-const CONFIGS: [(bool, bool, bool); 5] =
-    [(false, false, false), (false, true, true), (true, false, false), (true, true, false), (true, true, true)];
+const CONFIGS: [(bool, bool, bool); 5] = [
+    (false, false, false),
+    (false, true, true),
+    (true, false, false),
+    (true, true, false),
+    (true, true, true),
+];
 
 fn fd_check(f: &mut dyn FnMut(&[f64]) -> f64, a: &[f64], g: &[f64], what: &str) {
     let h = 1e-6;
@@ -86,7 +122,14 @@ fn energy_gradient_matches_finite_differences() {
                     let mut gg = vec![0.0; m.n()];
                     m.objective_and_gradient(x, obj, &mut s, &mut gg)
                 };
-                fd_check(&mut f, &a, &g, &format!("energy {obj:?} spatial={spatial} ext={ext} free={free} trial={trial}"));
+                fd_check(
+                    &mut f,
+                    &a,
+                    &g,
+                    &format!(
+                        "energy {obj:?} spatial={spatial} ext={ext} free={free} trial={trial}"
+                    ),
+                );
             }
         }
     }
@@ -99,13 +142,47 @@ fn each_energy_term_gradient_matches_finite_differences() {
     let base = rod(true, true);
     let zero = Profile::Constant(1e-300);
     let variants = [
-        ("flexure", Rod { torsional: Some(zero), extensional: Some(zero), weight: Profile::Constant(0.0), ..base.clone() }),
-        ("torsion", Rod { extensional: Some(zero), weight: Profile::Constant(0.0), ..base.clone() }),
-        ("extension", Rod { torsional: Some(zero), weight: Profile::Constant(0.0), ..base.clone() }),
-        ("gravity", Rod { torsional: Some(zero), extensional: Some(zero), ..base.clone() }),
+        (
+            "flexure",
+            Rod {
+                torsional: Some(zero),
+                extensional: Some(zero),
+                weight: Profile::Constant(0.0),
+                ..base.clone()
+            },
+        ),
+        (
+            "torsion",
+            Rod {
+                extensional: Some(zero),
+                weight: Profile::Constant(0.0),
+                ..base.clone()
+            },
+        ),
+        (
+            "extension",
+            Rod {
+                torsional: Some(zero),
+                weight: Profile::Constant(0.0),
+                ..base.clone()
+            },
+        ),
+        (
+            "gravity",
+            Rod {
+                torsional: Some(zero),
+                extensional: Some(zero),
+                ..base.clone()
+            },
+        ),
     ];
     for (name, r) in variants {
-        let layout = Layout { basis: Basis::new(4), spatial: true, extensible: true, free_base: true };
+        let layout = Layout {
+            basis: Basis::new(4),
+            spatial: true,
+            extensible: true,
+            free_base: true,
+        };
         let m = Model::new(r, layout, Discretisation::default(), [0.0; 3], vec![], &[]);
         let a = random_a(&m, &mut rng, 0.5);
         let mut shape = Shape::default();
@@ -121,7 +198,12 @@ fn each_energy_term_gradient_matches_finite_differences() {
 }
 
 fn obstacle(name: &str, shape: ObstacleShape, position: [f64; 3]) -> Arc<Obstacle> {
-    Arc::new(Obstacle { name: name.into(), shape, position, rotation: [0.3, -0.2, 0.5] })
+    Arc::new(Obstacle {
+        name: name.into(),
+        shape,
+        position,
+        rotation: [0.3, -0.2, 0.5],
+    })
 }
 
 fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
@@ -129,23 +211,58 @@ fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
     let spatial = m.layout.spatial;
     let (verts, faces) = read_obj(include_str!("../planning_cases/meshes/cube.obj")).unwrap();
     let mesh = TriMesh::with_flags(
-        verts.iter().map(|p| v(p[0] * 1.2, p[1] * 1.2, p[2] * 1.2)).collect(),
+        verts
+            .iter()
+            .map(|p| v(p[0] * 1.2, p[1] * 1.2, p[2] * 1.2))
+            .collect(),
         faces,
         TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
     )
     .unwrap();
     let hull = ConvexPolyhedron::from_convex_hull(&[
-        v(0.0, 0.0, 0.0), v(0.6, 0.0, 0.1), v(0.0, 0.5, 0.0), v(0.1, 0.1, 0.7), v(0.4, 0.4, 0.4),
+        v(0.0, 0.0, 0.0),
+        v(0.6, 0.0, 0.1),
+        v(0.0, 0.5, 0.0),
+        v(0.1, 0.1, 0.7),
+        v(0.4, 0.4, 0.4),
     ])
     .unwrap();
     let shapes = vec![
-        obstacle("cuboid", ObstacleShape::Cuboid(Cuboid::new(v(0.3, 0.4, 0.25))), [0.2, 0.0, 0.9]),
-        obstacle("ball", ObstacleShape::Ball(Ball::new(0.35)), [0.3, 0.1, 1.2]),
-        obstacle("capsule", ObstacleShape::Capsule(Capsule::new(v(-0.3, 0.0, 0.0), v(0.4, 0.1, 0.2), 0.2)), [0.0, 0.0, 0.7]),
-        obstacle("cylinder", ObstacleShape::Cylinder(Cylinder::new(0.5, 0.3)), [0.3, 0.0, 1.3]),
-        obstacle("hull", ObstacleShape::ConvexHull(Arc::new(hull)), [0.0, -0.2, 0.6]),
-        obstacle("mesh", ObstacleShape::TriMesh(Arc::new(mesh)), [0.1, 0.0, 1.0]),
-        obstacle("half space", ObstacleShape::HalfSpace([0.6, 0.0, 0.8]), [0.0, 0.0, 1.0]),
+        obstacle(
+            "cuboid",
+            ObstacleShape::Cuboid(Cuboid::new(v(0.3, 0.4, 0.25))),
+            [0.2, 0.0, 0.9],
+        ),
+        obstacle(
+            "ball",
+            ObstacleShape::Ball(Ball::new(0.35)),
+            [0.3, 0.1, 1.2],
+        ),
+        obstacle(
+            "capsule",
+            ObstacleShape::Capsule(Capsule::new(v(-0.3, 0.0, 0.0), v(0.4, 0.1, 0.2), 0.2)),
+            [0.0, 0.0, 0.7],
+        ),
+        obstacle(
+            "cylinder",
+            ObstacleShape::Cylinder(Cylinder::new(0.5, 0.3)),
+            [0.3, 0.0, 1.3],
+        ),
+        obstacle(
+            "hull",
+            ObstacleShape::ConvexHull(Arc::new(hull)),
+            [0.0, -0.2, 0.6],
+        ),
+        obstacle(
+            "mesh",
+            ObstacleShape::TriMesh(Arc::new(mesh)),
+            [0.1, 0.0, 1.0],
+        ),
+        obstacle(
+            "half space",
+            ObstacleShape::HalfSpace([0.6, 0.0, 0.8]),
+            [0.0, 0.0, 1.0],
+        ),
     ];
     let samples: Vec<usize> = (0..=16).map(|j| m.boundary(j as f64 / 16.0)).collect();
     let ts: Vec<f64> = (0..=16).map(|j| j as f64 / 16.0).collect();
@@ -153,19 +270,45 @@ fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
         Box::new(PositionConstraint {
             name: "pos".into(),
             boundary: m.boundary(1.0),
-            rows: vec![(0, Bound::Equal(0.1)), (2, Bound::AtMost(0.5)), (2, Bound::AtLeast(0.2))],
+            rows: vec![
+                (0, Bound::Equal(0.1)),
+                (2, Bound::AtMost(0.5)),
+                (2, Bound::AtLeast(0.2)),
+            ],
         }),
-        Box::new(RelativePositionConstraint { name: "rel".into(), from: m.boundary(0.25), to: m.boundary(0.6), rows: vec![(0, 0.1), (2, 0.3)] }),
-        Box::new(OrientationConstraint::new(m, "ori".into(), 0.6, if spatial {
-            vec![(Field::Phi, 0.1), (Field::Theta, 0.2), (Field::Psi, -0.3)]
-        } else {
-            vec![(Field::Theta, 0.2)]
-        })),
-        Box::new(LinearConstraint { name: "lin".into(), rows: vec![(vec![(0, 1.0), (3, -2.0)], 0.5)] }),
+        Box::new(RelativePositionConstraint {
+            name: "rel".into(),
+            from: m.boundary(0.25),
+            to: m.boundary(0.6),
+            rows: vec![(0, 0.1), (2, 0.3)],
+        }),
+        Box::new(OrientationConstraint::new(
+            m,
+            "ori".into(),
+            0.6,
+            if spatial {
+                vec![
+                    (Angle::Field(Field::Phi), 0.1),
+                    (Angle::Field(Field::Theta), 0.2),
+                    (Angle::PhiPlusPsi, -0.3),
+                ]
+            } else {
+                vec![(Angle::Field(Field::Theta), 0.2)]
+            },
+        )),
+        Box::new(LinearConstraint {
+            name: "lin".into(),
+            rows: vec![(vec![(0, 1.0), (3, -2.0)], 0.5)],
+        }),
         Box::new(SelfContactConstraint::new(samples.clone(), &ts, 0.9)),
     ];
     for o in shapes {
-        out.push(Box::new(ObstacleConstraint { obstacle: o, samples: samples.clone(), clearance: 0.01, length: 2.0 }));
+        out.push(Box::new(ObstacleConstraint {
+            obstacle: o,
+            samples: samples.clone(),
+            clearance: 0.01,
+            length: 2.0,
+        }));
     }
     out
 }
@@ -216,13 +359,23 @@ fn every_constraint_jacobian_matches_finite_differences() {
                         skipped += 1;
                     } else {
                         checked += 1;
-                        fd_check(&mut f, &a, &jac, &format!("{label} row {r} spatial={spatial} ext={ext} free={free} trial={trial}"));
+                        fd_check(
+                            &mut f,
+                            &a,
+                            &jac,
+                            &format!(
+                                "{label} row {r} spatial={spatial} ext={ext} free={free} trial={trial}"
+                            ),
+                        );
                     }
                 }
             }
         }
     }
-    assert!(skipped * 20 < checked, "too many rows on kinks: {skipped} skipped, {checked} checked");
+    assert!(
+        skipped * 20 < checked,
+        "too many rows on kinks: {skipped} skipped, {checked} checked"
+    );
 }
 
 #[test]
@@ -232,14 +385,34 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
     assert!((d + 0.3).abs() < 1e-12 && (n[2] - 1.0).abs() < 1e-12);
     let (d, _) = b.signed_distance([1.0, 2.0, 4.0]);
     assert!((d - 0.5).abs() < 1e-12);
-    let h = obstacle("hs", ObstacleShape::HalfSpace([0.0, 0.0, 1.0]), [0.0, 0.0, 0.8]);
-    let h = Obstacle { rotation: [0.0; 3], ..(*h).clone() };
+    let h = obstacle(
+        "hs",
+        ObstacleShape::HalfSpace([0.0, 0.0, 1.0]),
+        [0.0, 0.0, 0.8],
+    );
+    let h = Obstacle {
+        rotation: [0.0; 3],
+        ..(*h).clone()
+    };
     assert!((h.signed_distance([0.0, 0.0, 1.3]).0 - 0.5).abs() < 1e-12);
     assert!((h.signed_distance([5.0, 1.0, 0.3]).0 + 0.5).abs() < 1e-12);
     // A point deep inside a closed oriented mesh is recognised as inside.
     let (verts, faces) = read_obj(include_str!("../planning_cases/meshes/cube.obj")).unwrap();
-    let mesh = TriMesh::with_flags(verts.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect(), faces, TriMeshFlags::ORIENTED).unwrap();
-    let mo = Obstacle { name: "m".into(), shape: ObstacleShape::TriMesh(Arc::new(mesh)), position: [0.0; 3], rotation: [0.0; 3] };
+    let mesh = TriMesh::with_flags(
+        verts
+            .iter()
+            .map(|p| Vector::new(p[0], p[1], p[2]))
+            .collect(),
+        faces,
+        TriMeshFlags::ORIENTED,
+    )
+    .unwrap();
+    let mo = Obstacle {
+        name: "m".into(),
+        shape: ObstacleShape::TriMesh(Arc::new(mesh)),
+        position: [0.0; 3],
+        rotation: [0.0; 3],
+    };
     assert!((mo.signed_distance([0.1, 0.0, 0.0]).0 + 0.4).abs() < 1e-12);
     assert!((mo.signed_distance([0.0, 0.0, 0.9]).0 - 0.4).abs() < 1e-12);
 }

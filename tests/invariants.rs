@@ -10,7 +10,10 @@ use dlo_planner::rod::{Profile, Rod};
 fn rod() -> Rod {
     Rod {
         length: 3.0,
-        flexural: Profile::Linear { start: 2.0, end: 1.0 },
+        flexural: Profile::Linear {
+            start: 2.0,
+            end: 1.0,
+        },
         torsional: Some(Profile::Constant(0.8)),
         extensional: Some(Profile::Constant(50.0)),
         weight: Profile::Constant(0.0),
@@ -19,7 +22,12 @@ fn rod() -> Rod {
 }
 
 fn model(base: [f64; 3]) -> Model {
-    let layout = Layout { basis: Basis::new(4), spatial: true, extensible: true, free_base: false };
+    let layout = Layout {
+        basis: Basis::new(4),
+        spatial: true,
+        extensible: true,
+        free_base: false,
+    };
     Model::new(rod(), layout, Discretisation::default(), base, vec![], &[])
 }
 
@@ -33,7 +41,10 @@ fn straight_rod_has_zero_elastic_energy() {
         a[lay.offset(Field::Theta).unwrap()] = theta;
         a[lay.offset(Field::Psi).unwrap()] = psi;
         let t = m.energy(&a, &m.evaluate(&a), Objective::Potential, None);
-        assert!(t.flexural.abs() < 1e-14 && t.torsional.abs() < 1e-14 && t.extensional.abs() < 1e-14, "{t:?}");
+        assert!(
+            t.flexural.abs() < 1e-14 && t.torsional.abs() < 1e-14 && t.extensional.abs() < 1e-14,
+            "{t:?}"
+        );
         // And it is straight: |x(L) − x(0)| = L.
         let s = m.evaluate(&a);
         let e = s.positions.last().unwrap();
@@ -46,7 +57,9 @@ fn elastic_energy_is_invariant_under_rigid_motion_of_the_base() {
     let m0 = model([0.0; 3]);
     let m1 = model([0.3, -1.2, 4.0]);
     let lay = m0.layout;
-    let a: Vec<f64> = (0..m0.n()).map(|i| 0.3 * ((i * 7 % 11) as f64 - 5.0) / 5.0).collect();
+    let a: Vec<f64> = (0..m0.n())
+        .map(|i| 0.3 * ((i * 7 % 11) as f64 - 5.0) / 5.0)
+        .collect();
     let elastic = |m: &Model, a: &[f64]| {
         let t = m.energy(a, &m.evaluate(a), Objective::Potential, None);
         (t.flexural, t.torsional, t.extensional)
@@ -72,11 +85,26 @@ fn elastic_energy_is_invariant_under_rigid_motion_of_the_base() {
 
 #[test]
 fn planar_flexure_is_invariant_under_rotation_in_the_plane() {
-    let layout = Layout { basis: Basis::new(4), spatial: false, extensible: false, free_base: false };
-    let m = Model::new(rod(), layout, Discretisation::default(), [0.0; 3], vec![], &[]);
+    let layout = Layout {
+        basis: Basis::new(4),
+        spatial: false,
+        extensible: false,
+        free_base: false,
+    };
+    let m = Model::new(
+        rod(),
+        layout,
+        Discretisation::default(),
+        [0.0; 3],
+        vec![],
+        &[],
+    );
     let a: Vec<f64> = (0..m.n()).map(|i| 0.2 * (i as f64).cos()).collect();
     let mut b = a.clone();
     b[0] += 1.3;
-    let f = |a: &[f64]| m.energy(a, &m.evaluate(a), Objective::Potential, None).flexural;
+    let f = |a: &[f64]| {
+        m.energy(a, &m.evaluate(a), Objective::Potential, None)
+            .flexural
+    };
     assert!((f(&a) - f(&b)).abs() < 1e-12);
 }

@@ -25,12 +25,19 @@ fn clamped(l_over_len: f64, rod_extra: &str) -> String {
 /// Positions at `n+1` equally spaced points.
 fn profile(c: &case::Case, a: &[f64], n: usize) -> Vec<[f64; 3]> {
     let m = &c.problem.model;
-    (0..=n).map(|j| m.position_at(a, j as f64 / n as f64).map(|v| v * m.rod.length)).collect()
+    (0..=n)
+        .map(|j| {
+            m.position_at(a, j as f64 / n as f64)
+                .map(|v| v * m.rod.length)
+        })
+        .collect()
 }
 
 fn asymmetry(c: &case::Case, a: &[f64]) -> f64 {
     let p = profile(c, a, 40);
-    (0..=20).map(|j| (p[j][0] - p[40 - j][0]).abs()).fold(0.0, f64::max)
+    (0..=20)
+        .map(|j| (p[j][0] - p[40 - j][0]).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -38,18 +45,31 @@ fn extension_lowers_height_and_length_as_rho_e_falls() {
     // §4.4: clamped ends at 0.6 L; rho_e = Re L²/Rf = ∞, 500, 300, 200, 100.
     let mut prev: Option<(f64, f64)> = None;
     for rho_e in [f64::INFINITY, 500.0, 300.0, 200.0, 100.0] {
-        let extra = if rho_e.is_finite() { format!(r#", "extensional_rigidity": {}"#, rho_e / 1e4) } else { String::new() };
+        let extra = if rho_e.is_finite() {
+            format!(r#", "extensional_rigidity": {}"#, rho_e / 1e4)
+        } else {
+            String::new()
+        };
         let (c, sol) = solve_json(&clamped(0.6, &extra), None);
         assert_eq!(sol.status, SolveStatus::Converged, "rho_e={rho_e}");
         let m = &c.problem.model;
-        let height = profile(&c, &sol.a, 80).iter().map(|p| p[0].abs()).fold(0.0, f64::max);
+        let height = profile(&c, &sol.a, 80)
+            .iter()
+            .map(|p| p[0].abs())
+            .fold(0.0, f64::max);
         let length: f64 = (0..m.mesh.nodes.len())
             .map(|q| m.mesh.weights[q] * (1.0 + m.strain_at(&sol.a, m.mesh.nodes[q])))
             .sum::<f64>()
             * 100.0;
-        eprintln!("rho_e = {rho_e}: height {height:.3}, length {length:.3}, U = {:.5}", sol.energy.potential());
+        eprintln!(
+            "rho_e = {rho_e}: height {height:.3}, length {length:.3}, U = {:.5}",
+            sol.energy.potential()
+        );
         if let Some((h, l)) = prev {
-            assert!(height < h && length < l, "height and length must fall as rho_e falls");
+            assert!(
+                height < h && length < l,
+                "height and length must fall as rho_e falls"
+            );
         }
         prev = Some((height, length));
     }
@@ -74,12 +94,98 @@ fn gravity_lowers_the_clamped_arch_until_it_snaps_to_a_hanging_shape() {
         assert_eq!(sol.stable, Some(true));
         let p = profile(&c, &sol.a, 40);
         let mid = p[20][0];
-        eprintln!("rho_g = {rho_g}: U = {:.5}, mid-span height {mid:.3}, asymmetry {:.2e}", sol.energy.potential(), asymmetry(&c, &sol.a));
+        eprintln!(
+            "rho_g = {rho_g}: U = {:.5}, mid-span height {mid:.3}, asymmetry {:.2e}",
+            sol.energy.potential(),
+            asymmetry(&c, &sol.a)
+        );
         heights.push(mid);
         if rho_g == 0.0 {
             assert!(asymmetry(&c, &sol.a) < 1e-6);
         }
     }
-    assert!(heights[0] > heights[1] && heights[1] > heights[2] && heights[2] > 0.0, "{heights:?}");
-    assert!(heights[3] < 0.0 && heights[4] < 0.0, "snapped to hanging: {heights:?}");
+    assert!(
+        heights[0] > heights[1] && heights[1] > heights[2] && heights[2] > 0.0,
+        "{heights:?}"
+    );
+    assert!(
+        heights[3] < 0.0 && heights[4] < 0.0,
+        "snapped to hanging: {heights:?}"
+    );
+}
+
+fn shipped(name: &str) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("planning_cases")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// The shipped §4.3 cases with the end distance replaced.
+fn at_distance(name: &str, l: f64) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(&shipped(name)).unwrap();
+    v["constraints"][1]["z"] = serde_json::json!(l * 100.0);
+    v.to_string()
+}
+
+#[test]
+fn knot_free_and_one_knot_energies_cross_near_three_tenths() {
+    // §4.3, ρt = 0.77: flexure-only planar shape vs one-knot (flexure + torsion) shape.
+    let ls = [0.1, 0.2, 0.3, 0.4, 0.5];
+    let mut diff = Vec::new();
+    for &l in &ls {
+        let (_, free) = solve_json(&at_distance("topology_knot_free_020.json", l), None);
+        let (_, knot) = solve_json(&at_distance("topology_one_knot_020.json", l), None);
+        for s in [&free, &knot] {
+            assert_eq!(s.status, SolveStatus::Converged, "l/L = {l}");
+        }
+        let (uf, uk) = (free.energy.potential(), knot.energy.potential());
+        eprintln!(
+            "l/L = {l}: knot-free U = {uf:.4}, one-knot U = {uk:.4} (torsional {:.4})",
+            knot.energy.torsional
+        );
+        assert!(
+            knot.energy.torsional > 0.01 * uk,
+            "the one-knot shape is twisted"
+        );
+        diff.push(uk - uf);
+    }
+    // One sign change, between consecutive samples; interpolate the crossing.
+    let j = diff
+        .windows(2)
+        .position(|w| w[0] < 0.0 && w[1] > 0.0)
+        .expect("energies cross");
+    assert!(diff[..=j].iter().all(|d| *d < 0.0) && diff[j + 1..].iter().all(|d| *d > 0.0));
+    let cross = ls[j] + (ls[j + 1] - ls[j]) * (-diff[j]) / (diff[j + 1] - diff[j]);
+    eprintln!("crossing at l/L = {cross:.3}");
+    assert!((0.2..=0.35).contains(&cross), "paper: ≈ 0.3; got {cross}");
+}
+
+#[test]
+fn twisted_rod_kinks_into_a_loop_when_shortened() {
+    // §4.3 kinking: twist 2π, then shorten. A looped (knotted) shape, with φ winding about once
+    // and less torsional energy than the straight twisted rod (½ Rt (2π)²/L), is found at every
+    // l, with lower energy than the unlooped shape the default start reaches.
+    let straight_twist = 0.5 * 0.77 * (2.0 * std::f64::consts::PI).powi(2) / 100.0;
+    for l in [0.8, 0.6, 0.4, 0.2] {
+        let text = at_distance("kinking_twist_2pi_080.json", l);
+        let (c, loop_sol) = solve_json(&text, None);
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v.as_object_mut().unwrap().remove("shape");
+        let (_, plain) = solve_json(&v.to_string(), None);
+        let winding = c.problem.model.angles_at(&loop_sol.a, 1.0)[0];
+        eprintln!(
+            "l/L = {l}: looped U = {:.4} (torsional {:.4}, φ(L) = {winding:.2}); default start U = {:.4}",
+            loop_sol.energy.potential(),
+            loop_sol.energy.torsional,
+            plain.energy.potential()
+        );
+        assert_eq!(loop_sol.status, SolveStatus::Converged);
+        assert_eq!(loop_sol.stable, Some(true));
+        assert!(winding > 4.0, "a loop: φ winds by about 2π");
+        assert!(loop_sol.energy.torsional < straight_twist);
+        assert!(loop_sol.energy.potential() <= plain.energy.potential() + 1e-9);
+    }
 }

@@ -13,7 +13,7 @@ mod self_contact;
 
 pub use linear::LinearConstraint;
 pub use obstacle::ObstacleConstraint;
-pub use orientation::OrientationConstraint;
+pub use orientation::{Angle, OrientationConstraint};
 pub use position::{Bound, PositionConstraint, RelativePositionConstraint};
 pub use self_contact::SelfContactConstraint;
 
@@ -33,7 +33,10 @@ pub struct Adjoint {
 impl Adjoint {
     /// A zeroed accumulator for `model`.
     pub fn new(model: &Model) -> Adjoint {
-        Adjoint { pos: vec![[0.0; 3]; model.mesh.boundaries.len()], coef: vec![0.0; model.n()] }
+        Adjoint {
+            pos: vec![[0.0; 3]; model.mesh.boundaries.len()],
+            coef: vec![0.0; model.n()],
+        }
     }
 
     /// Zeroes every entry.

@@ -51,7 +51,11 @@ impl Constraint for PositionConstraint {
     }
     fn add_gradient(&self, _m: &Model, _a: &[f64], _s: &Shape, w: &[f64], adj: &mut Adjoint) {
         for (&wi, &(k, b)) in w.iter().zip(&self.rows) {
-            let sign = if matches!(b, Bound::AtLeast(_)) { -1.0 } else { 1.0 };
+            let sign = if matches!(b, Bound::AtLeast(_)) {
+                -1.0
+            } else {
+                1.0
+            };
             let mut v = [0.0; 3];
             v[k] = sign;
             adj.add_pos(self.boundary, wi, v);

@@ -31,7 +31,11 @@ impl SelfContactConstraint {
                 }
             }
         }
-        SelfContactConstraint { samples, pairs, min_distance }
+        SelfContactConstraint {
+            samples,
+            pairs,
+            min_distance,
+        }
     }
 }
 
@@ -54,7 +58,11 @@ pub fn segment_distance(p1: [f64; 3], q1: [f64; 3], p2: [f64; 3], q2: [f64; 3]) 
         } else {
             let b = dot(d1, d2);
             let denom = a * e - b * b;
-            let mut s = if denom > 1e-14 * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut s = if denom > 1e-14 * a * e {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let mut t = (b * s + f) / e;
             if t < 0.0 {
                 t = 0.0;
@@ -74,7 +82,10 @@ pub fn segment_distance(p1: [f64; 3], q1: [f64; 3], p2: [f64; 3], q2: [f64; 3]) 
 
 impl SelfContactConstraint {
     fn chord(&self, shape: &Shape, i: usize) -> ([f64; 3], [f64; 3]) {
-        (shape.positions[self.samples[i]], shape.positions[self.samples[i + 1]])
+        (
+            shape.positions[self.samples[i]],
+            shape.positions[self.samples[i + 1]],
+        )
     }
 }
 
@@ -108,7 +119,11 @@ impl Constraint for SelfContactConstraint {
             }
             let c1: Vec<f64> = (0..3).map(|k| p1[k] + s * (q1[k] - p1[k])).collect();
             let c2: Vec<f64> = (0..3).map(|k| p2[k] + t * (q2[k] - p2[k])).collect();
-            let n = [(c1[0] - c2[0]) / d, (c1[1] - c2[1]) / d, (c1[2] - c2[2]) / d];
+            let n = [
+                (c1[0] - c2[0]) / d,
+                (c1[1] - c2[1]) / d,
+                (c1[2] - c2[2]) / d,
+            ];
             // c = min − d: ∂c/∂x = −∂d/∂x.
             adj.add_pos(self.samples[i], -wi * (1.0 - s), n);
             adj.add_pos(self.samples[i + 1], -wi * s, n);

@@ -20,7 +20,7 @@ use nalgebra::{DMatrix, DVector};
 pub struct AlOptions {
     /// Required constraint violation `max(|c_eq|, max(0, c_ineq))`.
     pub feasibility_tol: f64,
-    /// Required KKT residual `‖∇f + Jᵀλ‖∞`.
+    /// Required KKT residual, relative: `‖∇f + Jᵀλ‖∞ ≤ optimality_tol · max(1, ‖∇f‖∞)`.
     pub optimality_tol: f64,
     /// Initial penalty.
     pub rho_initial: f64,
@@ -89,10 +89,12 @@ pub struct AlOutcome {
 
 /// Constraint violation of values `c`.
 pub fn violation(p: &impl Nlp, c: &[f64]) -> f64 {
-    c.iter().enumerate().fold(0.0, |m, (i, &v)| match p.sense(i) {
-        Sense::Equal => m.max(v.abs()),
-        Sense::LessEq => m.max(v),
-    })
+    c.iter()
+        .enumerate()
+        .fold(0.0, |m, (i, &v)| match p.sense(i) {
+            Sense::Equal => m.max(v.abs()),
+            Sense::LessEq => m.max(v),
+        })
 }
 
 /// Solves `p` from `x` (updated in place), warm-starting the multipliers from `lambda0` if given.
@@ -145,7 +147,11 @@ pub fn augmented_lagrangian<P: Nlp>(
                 },
                 x,
                 &mut h,
-                BfgsOptions { grad_tol: inner_tol, max_iter: opts.max_inner, f_rel_tol: 0.0 },
+                BfgsOptions {
+                    grad_tol: inner_tol,
+                    max_iter: opts.max_inner,
+                    f_rel_tol: 0.0,
+                },
             )
         };
         inner_iterations += out.iterations;
@@ -170,7 +176,10 @@ pub fn augmented_lagrangian<P: Nlp>(
             }
         }
         let inner_ok = out.grad_norm <= opts.optimality_tol
-            || matches!(out.status, BfgsStatus::LineSearchFailed | BfgsStatus::Stalled);
+            || matches!(
+                out.status,
+                BfgsStatus::LineSearchFailed | BfgsStatus::Stalled
+            );
         if viol <= opts.feasibility_tol && inner_ok && inner_tol <= opts.optimality_tol {
             status = AlStatus::Converged;
             break;
@@ -196,19 +205,21 @@ pub fn augmented_lagrangian<P: Nlp>(
         }
     };
     let max_violation = violation(p, &c);
+    let grad_scale = {
+        let mut g = vec![0.0; n];
+        p.values(x, &mut c);
+        p.gradient(x, &vec![0.0; m], &mut g);
+        g.iter().fold(1.0_f64, |acc, v| acc.max(v.abs()))
+    };
+    let kkt_ok = kkt <= opts.optimality_tol * grad_scale;
     if !f.is_finite() {
         status = AlStatus::NumericalFailure;
-    } else if status == AlStatus::Converged
-        && (kkt > opts.optimality_tol * 10.0 || max_violation > opts.feasibility_tol * 10.0)
-    {
+    } else if status == AlStatus::Converged && (!kkt_ok || max_violation > opts.feasibility_tol) {
         status = AlStatus::IterationLimit;
-    } else if status == AlStatus::IterationLimit
-        && max_violation <= opts.feasibility_tol
-        && kkt <= opts.optimality_tol
+    } else if status == AlStatus::IterationLimit && max_violation <= opts.feasibility_tol && kkt_ok
     {
         status = AlStatus::Converged;
     }
-    let _ = n;
     AlOutcome {
         status,
         f,
@@ -288,7 +299,9 @@ pub fn least_squares_multipliers<P: Nlp>(
         let jt = DMatrix::from_fn(n, k, |i, j| rows[j].1[i]);
         let rhs = -DVector::from_column_slice(&g0);
         let svd = jt.clone().svd(true, true);
-        let sol = svd.solve(&rhs, 1e-12 * svd.singular_values.max().max(1e-300)).ok()?;
+        let sol = svd
+            .solve(&rhs, 1e-12 * svd.singular_values.max().max(1e-300))
+            .ok()?;
         let worst = (0..k)
             .filter(|&j| p.sense(rows[j].0) == Sense::LessEq && sol[j] < 0.0)
             .min_by(|&a, &b| sol[a].total_cmp(&sol[b]));

@@ -16,7 +16,11 @@ pub struct BfgsOptions {
 
 impl Default for BfgsOptions {
     fn default() -> Self {
-        BfgsOptions { grad_tol: 1e-8, max_iter: 500, f_rel_tol: 0.0 }
+        BfgsOptions {
+            grad_tol: 1e-8,
+            max_iter: 500,
+            f_rel_tol: 0.0,
+        }
     }
 }
 
@@ -177,7 +181,13 @@ pub fn bfgs(
             BfgsStatus::IterationLimit
         }
     };
-    BfgsOutcome { f, grad_norm: inf_norm(&g), iterations, evaluations: evals, status }
+    BfgsOutcome {
+        f,
+        grad_norm: inf_norm(&g),
+        iterations,
+        evaluations: evals,
+        status,
+    }
 }
 
 #[cfg(test)]
@@ -226,7 +236,12 @@ mod tests {
         };
         let mut x = vec![0.0; 10];
         let mut h = Vec::new();
-        let out = bfgs(fg, &mut x, &mut h, BfgsOptions::default());
+        // ‖∇f‖∞ ≤ 1e-12 bounds the error by 1e-12 / λ_min(A) = 1e-12.
+        let opts = BfgsOptions {
+            grad_tol: 1e-12,
+            ..BfgsOptions::default()
+        };
+        let out = bfgs(fg, &mut x, &mut h, opts);
         assert_eq!(out.status, BfgsStatus::Converged);
         for (i, v) in x.iter().enumerate() {
             assert!((v - 1.0 / (i + 1) as f64).abs() < 1e-9);

@@ -29,7 +29,12 @@ pub struct WolfeParams {
 
 impl Default for WolfeParams {
     fn default() -> Self {
-        WolfeParams { c1: 1e-4, c2: 0.9, alpha_max: 1e10, max_evals: 30 }
+        WolfeParams {
+            c1: 1e-4,
+            c2: 0.9,
+            alpha_max: 1e10,
+            max_evals: 30,
+        }
     }
 }
 
@@ -56,12 +61,22 @@ pub fn strong_wolfe(
     let (mut a_prev, mut f_prev, mut d_prev) = (0.0, f0, d0);
     let mut alpha = alpha0.min(p.alpha_max);
     let mut evals = 0;
-    let mut best = Step { alpha: 0.0, f: f0, dphi: d0, wolfe: false };
+    let mut best = Step {
+        alpha: 0.0,
+        f: f0,
+        dphi: d0,
+        wolfe: false,
+    };
     loop {
         let (f, d) = phi(alpha);
         evals += 1;
         if f.is_finite() && f < best.f {
-            best = Step { alpha, f, dphi: d, wolfe: false };
+            best = Step {
+                alpha,
+                f,
+                dphi: d,
+                wolfe: false,
+            };
         }
         if !f.is_finite() {
             // Back off from a region where the objective is not defined.
@@ -72,13 +87,36 @@ pub fn strong_wolfe(
             continue;
         }
         if f > f0 + p.c1 * alpha * d0 || (evals > 1 && f >= f_prev) {
-            return zoom(&mut phi, f0, d0, (a_prev, f_prev, d_prev), (alpha, f, d), p, evals, best);
+            return zoom(
+                &mut phi,
+                f0,
+                d0,
+                (a_prev, f_prev, d_prev),
+                (alpha, f, d),
+                p,
+                evals,
+                best,
+            );
         }
         if d.abs() <= -p.c2 * d0 {
-            return Step { alpha, f, dphi: d, wolfe: true };
+            return Step {
+                alpha,
+                f,
+                dphi: d,
+                wolfe: true,
+            };
         }
         if d >= 0.0 {
-            return zoom(&mut phi, f0, d0, (alpha, f, d), (a_prev, f_prev, d_prev), p, evals, best);
+            return zoom(
+                &mut phi,
+                f0,
+                d0,
+                (alpha, f, d),
+                (a_prev, f_prev, d_prev),
+                p,
+                evals,
+                best,
+            );
         }
         if evals >= p.max_evals || alpha >= p.alpha_max {
             return best;
@@ -110,13 +148,23 @@ fn zoom(
         let (f, d) = phi(alpha);
         evals += 1;
         if f.is_finite() && f < best.f {
-            best = Step { alpha, f, dphi: d, wolfe: false };
+            best = Step {
+                alpha,
+                f,
+                dphi: d,
+                wolfe: false,
+            };
         }
         if !f.is_finite() || f > f0 + p.c1 * alpha * d0 || f >= lo.1 {
             hi = (alpha, f, d);
         } else {
             if d.abs() <= -p.c2 * d0 {
-                return Step { alpha, f, dphi: d, wolfe: true };
+                return Step {
+                    alpha,
+                    f,
+                    dphi: d,
+                    wolfe: true,
+                };
             }
             if d * (hi.0 - lo.0) >= 0.0 {
                 hi = lo;

@@ -58,6 +58,8 @@ pub fn null_space(j: &DMatrix<f64>) -> DMatrix<f64> {
     let jtj = j.transpose() * j;
     let eig = jtj.symmetric_eigen();
     let smax = eig.eigenvalues.amax().max(1e-300);
-    let cols: Vec<usize> = (0..n).filter(|&i| eig.eigenvalues[i] <= 1e-12 * smax).collect();
+    let cols: Vec<usize> = (0..n)
+        .filter(|&i| eig.eigenvalues[i] <= 1e-12 * smax)
+        .collect();
     DMatrix::from_fn(n, cols.len(), |r, k| eig.eigenvectors[(r, cols[k])])
 }

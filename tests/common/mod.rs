@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use dlo_planner::basis::Basis;
-use dlo_planner::constraints::{Bound, Constraint, OrientationConstraint, PositionConstraint};
+use dlo_planner::constraints::{
+    Angle, Bound, Constraint, OrientationConstraint, PositionConstraint,
+};
 use dlo_planner::layout::{Field, Layout};
 use dlo_planner::model::{Discretisation, Model};
 use dlo_planner::problem::StaticProblem;
@@ -38,7 +40,11 @@ pub fn pinned_elastica_load(ratio: f64) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         let (k, e) = ellip_ke(mid);
-        if 2.0 * e / k - 1.0 > ratio { lo = mid } else { hi = mid }
+        if 2.0 * e / k - 1.0 > ratio {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     let (k, _) = ellip_ke(0.5 * (lo + hi));
     4.0 * k * k
@@ -58,8 +64,20 @@ pub fn planar_rod(length: f64) -> Rod {
 
 /// Pinned–pinned compression to `ratio·L` with `pairs` basis pairs.
 pub fn pinned_problem(ratio: f64, pairs: usize) -> StaticProblem {
-    let layout = Layout { basis: Basis::new(pairs), spatial: false, extensible: false, free_base: false };
-    let model = Model::new(planar_rod(100.0), layout, Discretisation::default(), [0.0; 3], vec![], &[]);
+    let layout = Layout {
+        basis: Basis::new(pairs),
+        spatial: false,
+        extensible: false,
+        free_base: false,
+    };
+    let model = Model::new(
+        planar_rod(100.0),
+        layout,
+        Discretisation::default(),
+        [0.0; 3],
+        vec![],
+        &[],
+    );
     let end = model.boundary(1.0);
     let c: Vec<Box<dyn Constraint>> = vec![Box::new(PositionConstraint {
         name: "right pin".into(),
@@ -71,5 +89,10 @@ pub fn pinned_problem(ratio: f64, pairs: usize) -> StaticProblem {
 
 /// Clamped at `t = 0` (θ = 0) as an orientation constraint, for tests.
 pub fn clamp(model: &Model, t: f64) -> Box<dyn Constraint> {
-    Box::new(OrientationConstraint::new(model, "clamp".into(), t, vec![(Field::Theta, 0.0)]))
+    Box::new(OrientationConstraint::new(
+        model,
+        "clamp".into(),
+        t,
+        vec![(Angle::Field(Field::Theta), 0.0)],
+    ))
 }
