@@ -79,3 +79,25 @@ fn clamped_load_is_four_times_pinned() {
     assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
     assert!((load - exact).abs() / exact < 1e-3);
 }
+
+#[test]
+fn grasp_a_contact_forces_match_elastica() {
+    // §6.2 grasp (a): unilateral finger contacts at both ends, base free. The contact
+    // multipliers are the grasping force r0.
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases/grasp_a_080.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    for ratio in [0.95, 0.80, 0.60] {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["constraints"][1]["z"]["max"] = serde_json::json!(ratio * 100.0);
+        let mut c = dlo_planner::case::parse(&v.to_string(), &path).unwrap();
+        let sol = solve_static(&mut c.problem, &c.initial, &c.options);
+        let exact = pinned_elastica_load(ratio) / 1e4;
+        let (left, right) = (sol.reactions[0].force[2], -sol.reactions[1].force[2]);
+        eprintln!(
+            "grasp (a) l/L = {ratio}: r0 = {left:.6e} / {right:.6e}, closed form {exact:.6e}"
+        );
+        assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+        assert!((left - exact).abs() / exact < 1e-3 && (right - exact).abs() / exact < 1e-3);
+    }
+}
