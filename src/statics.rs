@@ -206,6 +206,32 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
         }
         out.push(r);
     }
+    if !m.layout.free_base {
+        // The fixed base P(0) is a pin: its force closes the global force balance
+        // F_base + Σ F_constraints + Σ p_loads − (∫D ds) x̂ = 0 (gravity along −x).
+        let mut f = [0.0; 3];
+        for r in &out {
+            for c in 0..3 {
+                f[c] -= r.force[c];
+            }
+        }
+        for ld in &m.loads {
+            for c in 0..3 {
+                f[c] -= ld.force[c] * fu;
+            }
+        }
+        f[0] += m.rod.weight.mean() * l;
+        out.insert(
+            0,
+            Reaction {
+                constraint: "base".into(),
+                s: Some(0.0),
+                force: f,
+                moment: [0.0; 3],
+                angle_torques: [0.0; 3],
+            },
+        );
+    }
     out
 }
 
