@@ -140,7 +140,7 @@ impl Model {
             if objective == Objective::Internal
                 && let Some(g) = grad
             {
-                self.add_positions_vjp(a, shape, &v, g);
+                self.add_positions_vjp(shape, &v, g);
             }
         }
         t

@@ -111,7 +111,7 @@ impl Model {
     /// Adds `Σ_b v[b] · ∂x(b)/∂a` to `grad`, for one vector `v[b]` per mesh boundary
     /// (dimensionless). One backward pass over the nodes: a node's tangent enters every
     /// position after it, so it sees the suffix sum of the `v`.
-    pub fn add_positions_vjp(&self, a: &[f64], shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
+    pub fn add_positions_vjp(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
         let lay = &self.layout;
         let nb = self.nb();
         let ot = 0;
@@ -127,7 +127,6 @@ impl Model {
                 grad[o + k] += total[c];
             }
         }
-        let _ = a;
         for j in (0..self.mesh.panels()).rev() {
             let vb = v[j + 1];
             suffix = [suffix[0] + vb[0], suffix[1] + vb[1], suffix[2] + vb[2]];
@@ -162,14 +161,14 @@ impl Model {
     }
 
     /// Jacobian `∂x(b)/∂a` of the position at boundary `b`: three rows of length `n`.
-    pub fn position_jacobian(&self, a: &[f64], shape: &Shape, b: usize) -> [Vec<f64>; 3] {
+    pub fn position_jacobian(&self, shape: &Shape, b: usize) -> [Vec<f64>; 3] {
         let n = self.n();
         let mut rows = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
         for (k, row) in rows.iter_mut().enumerate() {
             v[b] = [0.0; 3];
             v[b][k] = 1.0;
-            self.add_positions_vjp(a, shape, &v, row);
+            self.add_positions_vjp(shape, &v, row);
         }
         rows
     }

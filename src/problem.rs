@@ -104,6 +104,6 @@ impl Nlp for StaticProblem {
                 con.add_gradient(&self.model, x, &self.shape, w, &mut self.adj);
             }
         }
-        self.adj.finish(&self.model, x, &self.shape, g);
+        self.adj.finish(&self.model, &self.shape, g);
     }
 }

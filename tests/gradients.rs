@@ -1,8 +1,6 @@
 //! Finite-difference checks of every energy term's gradient and every constraint kind's
 //! Jacobian, on random coefficients, planar and 3D (the contract every constraint must pass).
 
-mod common;
-use common::*;
 use dlo_planner::basis::Basis;
 use dlo_planner::constraints::*;
 use dlo_planner::energy::Objective;
@@ -415,14 +413,4 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
     };
     assert!((mo.signed_distance([0.1, 0.0, 0.0]).0 + 0.4).abs() < 1e-12);
     assert!((mo.signed_distance([0.0, 0.0, 0.9]).0 - 0.4).abs() < 1e-12);
-}
-
-#[test]
-fn pinned_problem_gradients_are_consistent() {
-    // The test helper used elsewhere must itself be differentiable correctly.
-    let mut p = pinned_problem(0.8, 4);
-    let a: Vec<f64> = (0..p.n()).map(|i| 0.1 * (i as f64).sin()).collect();
-    let mut c = vec![0.0; p.m()];
-    p.values(&a, &mut c);
-    assert_eq!(c.len(), 2);
 }

@@ -54,11 +54,11 @@ impl Adjoint {
     }
 
     /// Adds the accumulated gradient to `grad`.
-    pub fn finish(&self, model: &Model, a: &[f64], shape: &Shape, grad: &mut [f64]) {
+    pub fn finish(&self, model: &Model, shape: &Shape, grad: &mut [f64]) {
         for (g, c) in grad.iter_mut().zip(&self.coef) {
             *g += c;
         }
-        model.add_positions_vjp(a, shape, &self.pos, grad);
+        model.add_positions_vjp(shape, &self.pos, grad);
     }
 }
 
