@@ -472,29 +472,22 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         return Err(v.err("rod.radius", format!("must be in [0, L/2), got {radius}")));
     }
     let d = file.discretisation;
-    if !(0..=32).contains(&d.basis_pairs) {
-        return Err(v.err(
-            "discretisation.basis_pairs",
-            format!("must be in 0..=32, got {}", d.basis_pairs),
-        ));
-    }
-    if !(1..=2000).contains(&d.panels) {
-        return Err(v.err(
-            "discretisation.panels",
-            format!("must be in 1..=2000, got {}", d.panels),
-        ));
-    }
-    if !(1..=16).contains(&d.gauss_points) {
-        return Err(v.err(
-            "discretisation.gauss_points",
-            format!("must be in 1..=16, got {}", d.gauss_points),
-        ));
-    }
-    if !(1..=2000).contains(&d.samples) {
-        return Err(v.err(
-            "discretisation.samples",
-            format!("must be in 1..=2000, got {}", d.samples),
-        ));
+    for (field, value, range) in [
+        ("discretisation.basis_pairs", d.basis_pairs, 0..=32),
+        ("discretisation.panels", d.panels, 1..=2000),
+        ("discretisation.gauss_points", d.gauss_points, 1..=16),
+        ("discretisation.samples", d.samples, 1..=2000),
+    ] {
+        if !range.contains(&value) {
+            return Err(v.err(
+                field,
+                format!(
+                    "must be in {}..={}, got {value}",
+                    range.start(),
+                    range.end()
+                ),
+            ));
+        }
     }
     let rod = Rod {
         length: l,

@@ -68,29 +68,36 @@ impl Obstacle {
         Pose::new(v3(self.position), v3(self.rotation))
     }
 
+    /// Projection of world point `pv` onto the surface, `None` for a half-space (analytic).
+    fn project(&self, pose: &Pose, pv: Vector) -> Option<parry3d_f64::query::PointProjection> {
+        Some(match &self.shape {
+            ObstacleShape::HalfSpace(_) => return None,
+            ObstacleShape::Cuboid(s) => s.project_point(pose, pv, false),
+            ObstacleShape::Ball(s) => s.project_point(pose, pv, false),
+            ObstacleShape::Capsule(s) => s.project_point(pose, pv, false),
+            ObstacleShape::Cylinder(s) => s.project_point(pose, pv, false),
+            ObstacleShape::ConvexHull(s) => s.project_point(pose, pv, false),
+            ObstacleShape::TriMesh(s) => s.project_point(pose, pv, false),
+        })
+    }
+
     /// Signed distance from world point `p` to the obstacle's surface (negative inside) and its
     /// gradient with respect to `p` (unit, pointing away from the obstacle).
     pub fn signed_distance(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
         let pose = self.pose();
         let pv = v3(p);
-        let proj = match &self.shape {
-            ObstacleShape::HalfSpace(n) => {
-                let nw = pose.rotation * v3(*n);
-                let d = (pv - pose.translation).dot(nw);
-                return (d, [nw.x, nw.y, nw.z]);
-            }
-            ObstacleShape::Cuboid(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Ball(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Capsule(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Cylinder(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::ConvexHull(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::TriMesh(s) => s.project_point(&pose, pv, false),
+        let Some(proj) = self.project(&pose, pv) else {
+            let ObstacleShape::HalfSpace(n) = &self.shape else {
+                unreachable!()
+            };
+            let nw = pose.rotation * v3(*n);
+            let d = (pv - pose.translation).dot(nw);
+            return (d, [nw.x, nw.y, nw.z]);
         };
         let diff = pv - proj.point;
         let dist = diff.length();
         if dist < 1e-14 {
-            // On the surface: use a central-difference normal of the unsigned distance field
-            // slightly outside.
+            // On the surface: the gradient of the signed distance by central differences.
             return (0.0, self.fallback_normal(p));
         }
         let n = diff / dist;
@@ -108,28 +115,23 @@ impl Obstacle {
             let (mut a, mut b) = (p, p);
             a[k] += h;
             b[k] -= h;
-            let (da, _) = self.signed_distance_no_fallback(a);
-            let (db, _) = self.signed_distance_no_fallback(b);
-            g[k] = (da - db) / (2.0 * h);
+            g[k] = (self.signed_distance_value(a) - self.signed_distance_value(b)) / (2.0 * h);
         }
         let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt().max(1e-300);
         [g[0] / n, g[1] / n, g[2] / n]
     }
 
-    fn signed_distance_no_fallback(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
+    /// Signed distance only (no normal), for the on-surface fallback.
+    fn signed_distance_value(&self, p: [f64; 3]) -> f64 {
         let pose = self.pose();
         let pv = v3(p);
-        let proj = match &self.shape {
-            ObstacleShape::HalfSpace(_) => return self.signed_distance(p),
-            ObstacleShape::Cuboid(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Ball(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Capsule(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::Cylinder(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::ConvexHull(s) => s.project_point(&pose, pv, false),
-            ObstacleShape::TriMesh(s) => s.project_point(&pose, pv, false),
-        };
-        let d = (pv - proj.point).length();
-        (if proj.is_inside { -d } else { d }, [0.0; 3])
+        match self.project(&pose, pv) {
+            None => self.signed_distance(p).0,
+            Some(proj) => {
+                let d = (pv - proj.point).length();
+                if proj.is_inside { -d } else { d }
+            }
+        }
     }
 }
 
