@@ -390,22 +390,22 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
     build(file, path)
 }
 
-struct V<'a> {
-    path: &'a Path,
+pub(crate) struct V<'a> {
+    pub(crate) path: &'a Path,
 }
 
 impl V<'_> {
-    fn err(&self, field: impl Into<String>, msg: impl Into<String>) -> Error {
+    pub(crate) fn err(&self, field: impl Into<String>, msg: impl Into<String>) -> Error {
         Error::invalid(self.path, field, msg)
     }
-    fn finite(&self, field: &str, v: f64) -> Result<f64, Error> {
+    pub(crate) fn finite(&self, field: &str, v: f64) -> Result<f64, Error> {
         if v.is_finite() {
             Ok(v)
         } else {
             Err(self.err(field, format!("must be finite, got {v}")))
         }
     }
-    fn positive(&self, field: &str, v: f64) -> Result<f64, Error> {
+    pub(crate) fn positive(&self, field: &str, v: f64) -> Result<f64, Error> {
         self.finite(field, v)?;
         if v > 0.0 {
             Ok(v)
@@ -777,7 +777,7 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     }
 
     let (initial, explicit_shape) = match &file.shape {
-        Some(sh) => (coefficients(&v, sh, &layout, base.map(|c| c / l))?, true),
+        Some(sh) => (coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?, true),
         None => (
             default_start(&layout, file.solver.perturbation, base.map(|c| c / l)),
             false,
@@ -962,7 +962,13 @@ fn spans_volume(points: &[[f64; 3]]) -> bool {
     ev.min() > 1e-12 * ev.max().max(1e-300)
 }
 
-fn coefficients(v: &V, sh: &ShapeSpec, layout: &Layout, base: [f64; 3]) -> Result<Vec<f64>, Error> {
+pub(crate) fn coefficients(
+    v: &V,
+    prefix: &str,
+    sh: &ShapeSpec,
+    layout: &Layout,
+    base: [f64; 3],
+) -> Result<Vec<f64>, Error> {
     let mut a = vec![0.0; layout.len()];
     let nb = layout.nb();
     for (nm, f, vals) in [
@@ -972,7 +978,7 @@ fn coefficients(v: &V, sh: &ShapeSpec, layout: &Layout, base: [f64; 3]) -> Resul
         ("eps", Field::Eps, &sh.eps),
     ] {
         let Some(vals) = vals else { continue };
-        let field = format!("shape.{nm}");
+        let field = format!("{prefix}.{nm}");
         let off = layout.offset(f).ok_or_else(|| {
             v.err(
                 &field,

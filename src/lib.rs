@@ -9,7 +9,8 @@
 //! discretised rod, [`kinematics`] turns coefficients into positions and frames, [`energy`]
 //! evaluates eq. (7)–(13) with gradients, [`constraints`] holds the geometric constraints of
 //! §3.2, [`optim`] the generic multiplier method and BFGS, and [`statics`] solves static shapes
-//! and reports reaction forces and stability. [`case`] reads case files.
+//! and reports reaction forces and stability. [`path`] and [`planner`] plan deformation paths
+//! (§7) and replay them by the controlled end. [`case`] reads case files.
 //!
 //! The library prints nothing.
 
@@ -20,9 +21,13 @@ pub mod energy;
 pub mod error;
 pub mod kinematics;
 pub mod layout;
+pub mod mcap_log;
 pub mod model;
 pub mod obstacle;
 pub mod optim;
+pub mod path;
+pub mod plot;
+pub mod planner;
 pub mod problem;
 pub mod quadrature;
 pub mod report;

@@ -1,15 +1,30 @@
 //! The `dlo` command-line tool: one run per case file.
 //!
 //! Exit codes: 0 success; 1 an output could not be written; 2 bad input (case file or usage);
-//! 3 the solver did not converge; 130 interrupted.
+//! 3 the solver did not converge; 4 no collision-free plan; 5 the replay does not coincide with
+//! the plan; 130 interrupted (the log is finished first).
 
 use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
+use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
+use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
+use dlo_planner::planner::{PlanStatus, Planner};
 use dlo_planner::report::{ShapeReport, coefficients_json, pose};
 use dlo_planner::statics::{evaluate_shape, solve_static};
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
+
+/// Exit code: an output could not be written.
+const EXIT_OUTPUT: u8 = 1;
+/// Exit code: no collision-free plan.
+const EXIT_COLLISION: u8 = 4;
+/// Exit code: the replay does not coincide with the plan.
+const EXIT_NOT_COINCIDENT: u8 = 5;
+/// Exit code: interrupted.
+const EXIT_INTERRUPTED: i32 = 130;
 
 /// Exit code: bad input.
 const EXIT_BAD_INPUT: u8 = 2;
@@ -36,6 +51,9 @@ enum Command {
         /// Print a JSON object on stdout instead of the readable summary.
         #[arg(long)]
         json: bool,
+        /// Directory of the MCAP log (`<case name>.mcap`).
+        #[arg(long, default_value = "logs")]
+        log_dir: PathBuf,
     },
     /// Evaluate the shape given by the case's explicit coefficients, without optimising.
     Energy {
@@ -44,6 +62,43 @@ enum Command {
         /// Print a JSON object on stdout.
         #[arg(long)]
         json: bool,
+    },
+    /// Plan a deformation path (the case's `plan` section), verify it and replay it by the
+    /// controlled end; log every shape to `<log-dir>/<case name>.mcap`.
+    Plan {
+        /// Case file (JSON) with a `plan` section.
+        case: PathBuf,
+        /// Print a JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+        /// Also write an SVG picture of the plan next to the log.
+        #[arg(long)]
+        plot: bool,
+        /// Directory of the MCAP log.
+        #[arg(long, default_value = "logs")]
+        log_dir: PathBuf,
+    },
+    /// Rewrite an MCAP file whose writer was killed into a fully indexed one.
+    Recover {
+        /// The broken file.
+        broken: PathBuf,
+        /// Where to write the recovered file.
+        fixed: PathBuf,
+    },
+    /// Print an MCAP file's topics, schemas, message counts and time range.
+    Inspect {
+        /// The file.
+        file: PathBuf,
+        /// Print a JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Draw the optimal and feasible paths of a plan's MCAP log as SVG.
+    Plot {
+        /// The log written by `dlo plan`.
+        file: PathBuf,
+        /// The SVG to write (default: the log's name with `.svg`).
+        output: Option<PathBuf>,
     },
 }
 
@@ -56,9 +111,64 @@ fn main() -> ExitCode {
         }
     };
     match cli.command {
-        Command::Shape { case, json } => run_shape(&case, json),
+        Command::Shape {
+            case,
+            json,
+            log_dir,
+        } => run_shape(&case, json, &log_dir),
         Command::Energy { case, json } => run_energy(&case, json),
+        Command::Plan {
+            case,
+            json,
+            plot,
+            log_dir,
+        } => run_plan(&case, json, plot, &log_dir),
+        Command::Recover { broken, fixed } => run_recover(&broken, &fixed),
+        Command::Inspect { file, json } => run_inspect(&file, json),
+        Command::Plot { file, output } => {
+            let out = output.unwrap_or_else(|| file.with_extension("svg"));
+            run_plot(&file, &out)
+        }
     }
+}
+
+/// The log being written, finished by the Ctrl-C handler.
+static ACTIVE_LOG: OnceLock<SharedWriter> = OnceLock::new();
+
+/// Opens `dir/<name>.mcap` and arms the Ctrl-C handler to finish it.
+fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode> {
+    let path = dir.join(format!("{name}.mcap"));
+    let w = McapWriter::create(&path).map_err(|e| {
+        eprintln!("error: {}: cannot create the log: {e}", path.display());
+        ExitCode::from(EXIT_OUTPUT)
+    })?;
+    let shared: SharedWriter = Arc::new(Mutex::new(w));
+    if ACTIVE_LOG.set(shared.clone()).is_ok() {
+        let _ = ctrlc::set_handler(|| {
+            if let Some(w) = ACTIVE_LOG.get() {
+                let mut w = match w.lock() {
+                    Ok(w) => w,
+                    Err(p) => p.into_inner(),
+                };
+                let _ = w.finish();
+            }
+            eprintln!("interrupted: the log was finished and is readable");
+            std::process::exit(EXIT_INTERRUPTED);
+        });
+    }
+    Ok((shared, path))
+}
+
+/// Finishes a log; reports failure as exit code 1.
+fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
+    let mut g = match w.lock() {
+        Ok(g) => g,
+        Err(p) => p.into_inner(),
+    };
+    g.finish().map_err(|e| {
+        eprintln!("error: {}: cannot finish the log: {e}", path.display());
+        ExitCode::from(EXIT_OUTPUT)
+    })
 }
 
 fn load(path: &std::path::Path) -> Result<Case, ExitCode> {
@@ -68,15 +178,27 @@ fn load(path: &std::path::Path) -> Result<Case, ExitCode> {
     })
 }
 
-fn run_shape(path: &std::path::Path, json: bool) -> ExitCode {
+fn run_shape(path: &std::path::Path, json: bool, log_dir: &Path) -> ExitCode {
     let mut c = match load(path) {
         Ok(c) => c,
+        Err(code) => return code,
+    };
+    let (log, log_path) = match open_log(log_dir, &c.name) {
+        Ok(l) => l,
         Err(code) => return code,
     };
     let t0 = Instant::now();
     let sol = solve_static(&mut c.problem, &c.initial, &c.options);
     let secs = t0.elapsed().as_secs_f64();
     let report = ShapeReport::solved(&c.name, &c.problem, &sol, &c.report_points, secs);
+    let metrics = serde_json::to_value(&report).expect("report serialises");
+    let logged = log_static(&log, &c.problem.model, &c.obstacles, &sol.a, &metrics)
+        .map_err(|e| e.to_string())
+        .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
+    if let Err(e) = logged {
+        eprintln!("error: {}: cannot write the log: {e}", log_path.display());
+        return ExitCode::from(EXIT_OUTPUT);
+    }
     print_report(&report, json);
     if sol.status == dlo_planner::statics::SolveStatus::Converged {
         ExitCode::SUCCESS
@@ -182,4 +304,314 @@ fn print_report(r: &ShapeReport, json: bool) {
     }
     let _ = writeln!(o, "  time {:.3} ms", r.timing_s * 1e3);
     emit(&o);
+}
+
+/// Progress on stderr (only when it is a terminal) plus the MCAP log.
+struct CliObserver {
+    log: PlanLog,
+    tty: bool,
+    started: Instant,
+}
+
+impl PlanObserver for CliObserver {
+    fn begin(&mut self, model: &dlo_planner::model::Model) {
+        self.log.begin(model);
+    }
+    fn phase(&mut self, name: &str) {
+        self.log.phase(name);
+        if self.tty {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] {name}",
+                self.started.elapsed().as_secs_f64()
+            );
+        }
+    }
+    fn shape(&mut self, model: &dlo_planner::model::Model, r: &ShapeRecord) {
+        self.log.shape(model, r);
+        if self.tty && r.kind == dlo_planner::planner::observer::PathKind::Feasible {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] replay k = {:.3}  d = {:.2e}",
+                self.started.elapsed().as_secs_f64(),
+                r.k,
+                r.deviation.unwrap_or(0.0)
+            );
+        }
+    }
+    fn progress(&mut self, model: &dlo_planner::model::Model, p: &Progress, worst: &[f64]) {
+        self.log.progress(model, p, worst);
+        if self.tty {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] optimise start {} stage {} iteration {}: max U {:.4e} at k = {:.3}, violation {:.1e}",
+                self.started.elapsed().as_secs_f64(),
+                p.start,
+                p.stage,
+                p.outer,
+                p.sampled_max,
+                p.k_worst,
+                p.violation
+            );
+        }
+    }
+}
+
+#[derive(serde::Serialize)]
+struct PlanReport<'a> {
+    case: &'a str,
+    #[serde(flatten)]
+    result: &'a dlo_planner::planner::PlanResult,
+    start_energy: f64,
+    goal_energy: f64,
+    mcap: String,
+    log_shapes: u64,
+}
+
+fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
+    let c = match load(path) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let t0 = Instant::now();
+    let planner = match Planner::from_case(&c) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let t_end = t0.elapsed().as_secs_f64();
+    let (log, log_path) = match open_log(log_dir, &c.name) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let mut obs = CliObserver {
+        log: PlanLog::new(log.clone(), c.obstacles.clone()),
+        tty: std::io::stderr().is_terminal(),
+        started: Instant::now(),
+    };
+    let mut result = planner.run(&mut obs);
+    result.timing_s.endpoints = t_end;
+    if obs.tty {
+        eprintln!();
+    }
+    if let Some(e) = obs.log.error() {
+        eprintln!("error: {}: cannot write the log: {e}", log_path.display());
+        let _ = close_log(&log, &log_path);
+        return ExitCode::from(EXIT_OUTPUT);
+    }
+    if let Err(code) = close_log(&log, &log_path) {
+        return code;
+    }
+    let report = PlanReport {
+        case: &c.name,
+        result: &result,
+        start_energy: planner.start.energy.internal(),
+        goal_energy: planner.goal.energy.internal(),
+        mcap: log_path.display().to_string(),
+        log_shapes: obs.log.shapes(),
+    };
+    if json {
+        emit(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(&report).expect("report serialises")
+        ));
+    } else {
+        emit(&plan_summary(&report));
+    }
+    if plot {
+        let svg = log_path.with_extension("svg");
+        if run_plot(&log_path, &svg) != ExitCode::SUCCESS {
+            return ExitCode::from(EXIT_OUTPUT);
+        }
+    }
+    match (result.status, result.replay.coincide) {
+        (PlanStatus::Collision, _) => {
+            eprintln!(
+                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4})",
+                path.display(),
+                result.min_clearance.unwrap_or(0.0),
+                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or("?", |o| o.obstacle.as_str()),
+                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or(0.0, |o| o.k),
+                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or(0.0, |o| o.s),
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
+        (PlanStatus::NotConverged, _) => {
+            eprintln!(
+                "error: {}: the path optimiser did not converge ({:?}, violation {:.2e})",
+                path.display(),
+                result.optimiser,
+                result.violation
+            );
+            ExitCode::from(EXIT_NOT_CONVERGED)
+        }
+        (PlanStatus::Planned, false) => {
+            eprintln!(
+                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}",
+                path.display(),
+                result.replay.max_deviation_over_l,
+                result.replay.k_at_max_deviation,
+                result.replay.tolerance,
+                if result.replay.snaps.is_empty() { String::new() } else { format!(", snap-through at k = {:?}", result.replay.snaps) }
+            );
+            ExitCode::from(EXIT_NOT_COINCIDENT)
+        }
+        (PlanStatus::Planned, true) => ExitCode::SUCCESS,
+    }
+}
+
+fn plan_summary(r: &PlanReport) -> String {
+    use std::fmt::Write;
+    let p = r.result;
+    let mut o = String::new();
+    let _ = writeln!(o, "case {}: {:?} (optimiser {:?})", r.case, p.status, p.optimiser);
+    let _ = writeln!(
+        o,
+        "  U_max {:.6e} at k = {:.3}   straight path U_max {:.6e}   start {:.6e}  goal {:.6e}",
+        p.u_max, p.k_at_u_max, p.u_max_straight, r.start_energy, r.goal_energy
+    );
+    let _ = writeln!(
+        o,
+        "  clearance {}   straight path clearance {}   optimiser violation {:.2e}",
+        p.min_clearance.map_or("n/a".into(), |c| format!("{c:.4e}")),
+        p.min_clearance_straight.map_or("n/a".into(), |c| format!("{c:.4e}")),
+        p.violation
+    );
+    let rp = &p.replay;
+    let _ = writeln!(
+        o,
+        "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snaps {:?}",
+        rp.max_deviation_over_l,
+        rp.k_at_max_deviation,
+        rp.tolerance,
+        if rp.coincide { "coincide" } else { "DO NOT COINCIDE" },
+        rp.u_max,
+        rp.all_stable,
+        rp.all_converged,
+        rp.snaps
+    );
+    let _ = writeln!(
+        o,
+        "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",
+        r.mcap, r.log_shapes, p.timing_s.endpoints, p.timing_s.plan, p.timing_s.replay
+    );
+    o
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, ExitCode> {
+    std::fs::read(path).map_err(|e| {
+        eprintln!("error: {}: cannot read: {e}", path.display());
+        ExitCode::from(EXIT_BAD_INPUT)
+    })
+}
+
+fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
+    let bytes = match read_file(broken) {
+        Ok(b) => b,
+        Err(c) => return c,
+    };
+    let tmp = fixed.with_extension("mcap.partial");
+    let out = match std::fs::File::create(&tmp) {
+        Ok(f) => std::io::BufWriter::new(f),
+        Err(e) => {
+            eprintln!("error: {}: cannot create: {e}", tmp.display());
+            return ExitCode::from(EXIT_OUTPUT);
+        }
+    };
+    match dlo_planner::mcap_log::recover::recover(&bytes, out) {
+        Ok(r) => {
+            if let Err(e) = std::fs::rename(&tmp, fixed) {
+                eprintln!("error: {}: cannot write: {e}", fixed.display());
+                return ExitCode::from(EXIT_OUTPUT);
+            }
+            emit(&format!(
+                "recovered {} messages from {} into {}{}\n",
+                r.messages,
+                broken.display(),
+                fixed.display(),
+                match (&r.truncated, &r.stopped_at) {
+                    (true, Some(s)) => format!(" (the input was cut short: {s})"),
+                    (true, None) => " (the input had no summary)".into(),
+                    _ => " (the input was complete)".into(),
+                }
+            ));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            eprintln!("error: {}: not an MCAP file: {e}", broken.display());
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
+}
+
+fn run_inspect(file: &Path, json: bool) -> ExitCode {
+    use std::fmt::Write;
+    let bytes = match read_file(file) {
+        Ok(b) => b,
+        Err(c) => return c,
+    };
+    let ins = match dlo_planner::mcap_log::inspect::inspect(&bytes) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("error: {}: not an MCAP file: {e}", file.display());
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    if json {
+        emit(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(&ins).expect("inspection serialises")
+        ));
+        return ExitCode::SUCCESS;
+    }
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "{}: {} messages, {} s to {} s, {}",
+        file.display(),
+        ins.messages,
+        ins.start_time.map_or(0.0, |t| t as f64 * 1e-9),
+        ins.end_time.map_or(0.0, |t| t as f64 * 1e-9),
+        if ins.indexed { "indexed" } else { "NOT indexed (run `dlo recover`)" }
+    );
+    for (name, t) in &ins.topics {
+        let _ = writeln!(
+            o,
+            "  {name:28} {:26} {:9} {:7} messages  {:8.3} s .. {:8.3} s",
+            t.schema,
+            t.encoding,
+            t.messages,
+            t.first_log_time as f64 * 1e-9,
+            t.last_log_time as f64 * 1e-9
+        );
+    }
+    if let Some(s) = &ins.stopped_at {
+        let _ = writeln!(o, "  the file ends early: {s}");
+    }
+    emit(&o);
+    ExitCode::SUCCESS
+}
+
+fn run_plot(file: &Path, out: &Path) -> ExitCode {
+    let bytes = match read_file(file) {
+        Ok(b) => b,
+        Err(c) => return c,
+    };
+    let frames = match dlo_planner::plot::read_frames(&bytes) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {}: {e}", file.display());
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let title = file
+        .file_stem()
+        .map_or("plan".into(), |s| s.to_string_lossy().into_owned());
+    match dlo_planner::plot::plot(&frames, &title, out) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}: {e}", out.display());
+            ExitCode::from(EXIT_OUTPUT)
+        }
+    }
 }

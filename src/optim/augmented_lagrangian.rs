@@ -97,12 +97,38 @@ pub fn violation(p: &impl Nlp, c: &[f64]) -> f64 {
         })
 }
 
+/// State after one outer iteration, handed to the observer of [`augmented_lagrangian_observed`].
+#[derive(Clone, Copy, Debug)]
+pub struct OuterIterate<'a> {
+    /// Outer iteration number (from 1).
+    pub outer: usize,
+    /// Objective `f(x)`.
+    pub f: f64,
+    /// Constraint violation (complementarity-aware) after the multiplier update.
+    pub violation: f64,
+    /// Penalty used in this iteration.
+    pub rho: f64,
+    /// The iterate.
+    pub x: &'a [f64],
+}
+
 /// Solves `p` from `x` (updated in place), warm-starting the multipliers from `lambda0` if given.
 pub fn augmented_lagrangian<P: Nlp>(
     p: &mut P,
     x: &mut [f64],
     lambda0: Option<&[f64]>,
     opts: AlOptions,
+) -> AlOutcome {
+    augmented_lagrangian_observed(p, x, lambda0, opts, &mut |_| {})
+}
+
+/// [`augmented_lagrangian`], calling `on_outer` after every outer iteration.
+pub fn augmented_lagrangian_observed<P: Nlp>(
+    p: &mut P,
+    x: &mut [f64],
+    lambda0: Option<&[f64]>,
+    opts: AlOptions,
+    on_outer: &mut dyn FnMut(&OuterIterate),
 ) -> AlOutcome {
     let (n, m) = (p.n(), p.m());
     let mut lambda = lambda0.map_or(vec![0.0; m], |l| l.to_vec());
@@ -160,7 +186,7 @@ pub fn augmented_lagrangian<P: Nlp>(
             status = AlStatus::NumericalFailure;
             break;
         }
-        p.values(x, &mut c);
+        let f_now = p.values(x, &mut c);
         evaluations += 1;
         let mut viol: f64 = 0.0;
         for i in 0..m {
@@ -175,6 +201,13 @@ pub fn augmented_lagrangian<P: Nlp>(
                 }
             }
         }
+        on_outer(&OuterIterate {
+            outer,
+            f: f_now,
+            violation: viol,
+            rho,
+            x,
+        });
         let inner_ok = out.grad_norm <= opts.optimality_tol
             || matches!(
                 out.status,

@@ -1,0 +1,12 @@
+//! MCAP logs for Foxglove: a streaming writer ([`writer`]), Foxglove scene messages
+//! ([`scene`]), the planner's observer ([`plan_log`]), and tools for finished or broken files
+//! ([`inspect`], [`recover`]).
+
+pub mod inspect;
+pub mod plan_log;
+pub mod recover;
+pub mod scene;
+pub mod writer;
+
+pub use plan_log::{PlanLog, SharedWriter, log_static};
+pub use writer::{LogError, McapWriter};

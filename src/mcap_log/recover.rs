@@ -1,0 +1,83 @@
+//! Rewrites an MCAP file whose writer was killed (no summary, maybe a torn last chunk) into a
+//! fully indexed one: every message a streaming reader can still reach is copied, with its
+//! channel and schema.
+
+use super::writer::LogError;
+use std::collections::HashMap;
+use std::io::{Seek, Write};
+
+/// What [`recover`] found.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Recovery {
+    /// Messages copied.
+    pub messages: u64,
+    /// Whether the input ended early (a torn record or a missing summary/footer).
+    pub truncated: bool,
+    /// The reader's complaint at the point it stopped, if any.
+    pub stopped_at: Option<String>,
+}
+
+/// Copies every readable message of `input` (the bytes of an MCAP file, complete or not) to a
+/// new, finished MCAP written on `out`.
+pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogError> {
+    let stream = mcap::MessageStream::new_with_options(
+        input,
+        enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),
+    )?;
+    let mut w = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .chunk_size(Some(super::writer::CHUNK_BYTES))
+        .profile("")
+        .create(out)?;
+    let mut channels: HashMap<u16, u16> = HashMap::new();
+    let mut schemas: HashMap<u16, u16> = HashMap::new();
+    let mut messages = 0;
+    let mut stopped_at = None;
+    for m in stream {
+        let m = match m {
+            Ok(m) => m,
+            Err(e) => {
+                stopped_at = Some(e.to_string());
+                break;
+            }
+        };
+        let ch = &m.channel;
+        let id = match channels.get(&ch.id) {
+            Some(&id) => id,
+            None => {
+                let sid = match &ch.schema {
+                    Some(s) => match schemas.get(&s.id) {
+                        Some(&sid) => sid,
+                        None => {
+                            let sid = w.add_schema(&s.name, &s.encoding, &s.data)?;
+                            schemas.insert(s.id, sid);
+                            sid
+                        }
+                    },
+                    None => 0,
+                };
+                let id = w.add_channel(sid, &ch.topic, &ch.message_encoding, &ch.metadata)?;
+                channels.insert(ch.id, id);
+                id
+            }
+        };
+        w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            },
+            &m.data,
+        )?;
+        messages += 1;
+    }
+    w.finish()?;
+    let complete = mcap::read::footer(input).is_ok()
+        && matches!(mcap::Summary::read(input), Ok(Some(_)));
+    Ok(Recovery {
+        messages,
+        truncated: stopped_at.is_some() || !complete,
+        stopped_at,
+    })
+}

@@ -1,0 +1,164 @@
+//! A streaming MCAP writer: zstd-compressed chunks written as they fill, Foxglove's protobuf
+//! schemas registered on first use, JSON for numeric topics, and per-topic sequence numbers.
+
+use foxglove::Encode;
+use std::collections::{BTreeMap, HashMap};
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
+
+/// Chunk size: small enough that a killed run loses little, large enough to compress well.
+pub const CHUNK_BYTES: u64 = 64 * 1024;
+
+/// The writer behind every log.
+pub struct McapWriter<W: Write + Seek> {
+    inner: Option<mcap::Writer<W>>,
+    channels: HashMap<String, u16>,
+    schemas: HashMap<String, u16>,
+    sequence: HashMap<u16, u32>,
+    buf: Vec<u8>,
+    messages: u64,
+}
+
+/// Errors of the log writer.
+pub type LogError = mcap::McapError;
+
+impl McapWriter<BufWriter<File>> {
+    /// Creates `path` (its directory too).
+    pub fn create(path: &Path) -> Result<Self, LogError> {
+        if let Some(dir) = path.parent()
+            && !dir.as_os_str().is_empty()
+        {
+            std::fs::create_dir_all(dir)?;
+        }
+        let file = BufWriter::new(File::create(path)?);
+        Self::new(file)
+    }
+}
+
+impl<W: Write + Seek> McapWriter<W> {
+    /// Starts a log on `w`.
+    pub fn new(w: W) -> Result<Self, LogError> {
+        let inner = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .chunk_size(Some(CHUNK_BYTES))
+            .profile("")
+            .library(format!("dlo-planner {}", env!("CARGO_PKG_VERSION")))
+            .create(w)?;
+        Ok(McapWriter {
+            inner: Some(inner),
+            channels: HashMap::new(),
+            schemas: HashMap::new(),
+            sequence: HashMap::new(),
+            buf: Vec::new(),
+            messages: 0,
+        })
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    fn writer(&mut self) -> Result<&mut mcap::Writer<W>, LogError> {
+        self.inner
+            .as_mut()
+            .ok_or_else(|| std::io::Error::other("log already finished").into())
+    }
+
+    fn channel(
+        &mut self,
+        topic: &str,
+        schema: (&str, &str, &[u8]),
+        message_encoding: &str,
+    ) -> Result<u16, LogError> {
+        if let Some(&id) = self.channels.get(topic) {
+            return Ok(id);
+        }
+        let sid = match self.schemas.get(schema.0) {
+            Some(&s) => s,
+            None => {
+                let s = self.writer()?.add_schema(schema.0, schema.1, schema.2)?;
+                self.schemas.insert(schema.0.to_string(), s);
+                s
+            }
+        };
+        let id = self
+            .writer()?
+            .add_channel(sid, topic, message_encoding, &BTreeMap::new())?;
+        self.channels.insert(topic.to_string(), id);
+        Ok(id)
+    }
+
+    fn put(&mut self, id: u16, log_time: u64) -> Result<(), LogError> {
+        let seq = self.sequence.entry(id).or_insert(0);
+        *seq += 1;
+        let header = mcap::records::MessageHeader {
+            channel_id: id,
+            sequence: *seq,
+            log_time,
+            publish_time: log_time,
+        };
+        let data = std::mem::take(&mut self.buf);
+        let r = self.writer()?.write_to_known_channel(&header, &data);
+        self.buf = data;
+        self.messages += 1;
+        r
+    }
+
+    /// Writes a Foxglove protobuf message on `topic` at `log_time` (ns).
+    pub fn proto<T: Encode>(&mut self, topic: &str, log_time: u64, msg: &T) -> Result<(), LogError> {
+        let schema = T::get_schema().expect("Foxglove schemas carry a descriptor");
+        let id = self.channel(
+            topic,
+            (&schema.name, &schema.encoding, &schema.data),
+            &T::get_message_encoding(),
+        )?;
+        self.buf.clear();
+        msg.encode(&mut self.buf)
+            .map_err(|e| std::io::Error::other(format!("encoding {topic}: {e:?}")))?;
+        self.put(id, log_time)
+    }
+
+    /// Writes a JSON message on `topic` with the JSON schema `schema` named `name`.
+    pub fn json(
+        &mut self,
+        topic: &str,
+        name: &str,
+        schema: &serde_json::Value,
+        log_time: u64,
+        msg: &serde_json::Value,
+    ) -> Result<(), LogError> {
+        let schema_bytes = serde_json::to_vec(schema).expect("schema serialises");
+        let id = self.channel(topic, (name, "jsonschema", &schema_bytes), "json")?;
+        self.buf.clear();
+        serde_json::to_writer(&mut self.buf, msg).expect("JSON serialises");
+        self.put(id, log_time)
+    }
+
+    /// Closes the current chunk so that everything so far is readable by a streaming reader.
+    pub fn flush(&mut self) -> Result<(), LogError> {
+        self.writer()?.flush()
+    }
+
+    /// Writes the summary and index; later calls do nothing.
+    pub fn finish(&mut self) -> Result<(), LogError> {
+        if let Some(mut w) = self.inner.take() {
+            w.finish()?;
+            let mut inner = w.into_inner();
+            inner.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Whether [`McapWriter::finish`] has run.
+    pub fn is_finished(&self) -> bool {
+        self.inner.is_none()
+    }
+}
+
+impl<W: Write + Seek> Drop for McapWriter<W> {
+    fn drop(&mut self) {
+        let _ = self.finish();
+    }
+}

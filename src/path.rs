@@ -1,0 +1,114 @@
+//! Deformation paths in coefficient space (paper §7.1, eq. 18):
+//! `a(c, k) = (1 − k) a0 + k a1 + Σᵢ₌₁..m cᵢ kⁱ (1 − k)`, `k ∈ [0, 1]`.
+//!
+//! Fixed conditions that are linear in the coefficients (e.g. `θ(0, k) = 0`) hold at both ends,
+//! so along the whole path they reduce to `C cᵢ = 0`. The path stores an orthonormal basis `N`
+//! of that null space and takes `cᵢ = N zᵢ`: the unknowns `z` satisfy the conditions exactly,
+//! with no multipliers and no drift.
+
+/// A deformation path between two shapes, parameterised by `z` (`m` blocks of `r` numbers).
+#[derive(Clone, Debug)]
+pub struct DeformationPath {
+    /// Initial shape `a(c, 0)`.
+    pub a0: Vec<f64>,
+    /// Goal shape `a(c, 1)`.
+    pub a1: Vec<f64>,
+    /// Number of path terms `m` (paper: 3).
+    pub terms: usize,
+    /// Orthonormal basis of the admissible directions, `r` columns of length `n`.
+    pub basis: Vec<Vec<f64>>,
+}
+
+impl DeformationPath {
+    /// A path with admissible directions orthogonal to every row of `linear_rows`
+    /// (all directions when there are none).
+    pub fn new(a0: Vec<f64>, a1: Vec<f64>, terms: usize, linear_rows: &[Vec<f64>]) -> Self {
+        let n = a0.len();
+        let basis = if linear_rows.is_empty() {
+            (0..n)
+                .map(|j| (0..n).map(|i| f64::from(u8::from(i == j))).collect())
+                .collect()
+        } else {
+            let c = nalgebra::DMatrix::from_fn(linear_rows.len(), n, |r, j| linear_rows[r][j]);
+            let ns = crate::optim::second_order::null_space(&c);
+            (0..ns.ncols())
+                .map(|q| ns.column(q).iter().copied().collect())
+                .collect()
+        };
+        DeformationPath {
+            a0,
+            a1,
+            terms,
+            basis,
+        }
+    }
+
+    /// Number of coefficients per shape.
+    pub fn n(&self) -> usize {
+        self.a0.len()
+    }
+
+    /// Number of unknowns `m · r`.
+    pub fn n_vars(&self) -> usize {
+        self.terms * self.basis.len()
+    }
+
+    /// Weight `kⁱ (1 − k)` of term `i` (from 1).
+    pub fn weight(i: usize, k: f64) -> f64 {
+        k.powi(i as i32) * (1.0 - k)
+    }
+
+    /// The path vectors `cᵢ = N zᵢ` in coefficient space.
+    pub fn c_vectors(&self, z: &[f64]) -> Vec<Vec<f64>> {
+        let r = self.basis.len();
+        (0..self.terms)
+            .map(|i| {
+                let mut c = vec![0.0; self.n()];
+                for (q, col) in self.basis.iter().enumerate() {
+                    let zq = z[i * r + q];
+                    if zq != 0.0 {
+                        for (cj, bj) in c.iter_mut().zip(col) {
+                            *cj += zq * bj;
+                        }
+                    }
+                }
+                c
+            })
+            .collect()
+    }
+
+    /// Writes `a(z, k)` into `out`.
+    pub fn shape_at(&self, z: &[f64], k: f64, out: &mut [f64]) {
+        for ((o, &x0), &x1) in out.iter_mut().zip(&self.a0).zip(&self.a1) {
+            *o = (1.0 - k) * x0 + k * x1;
+        }
+        let r = self.basis.len();
+        for i in 0..self.terms {
+            let w = Self::weight(i + 1, k);
+            for (q, col) in self.basis.iter().enumerate() {
+                let zq = w * z[i * r + q];
+                if zq != 0.0 {
+                    for (o, bj) in out.iter_mut().zip(col) {
+                        *o += zq * bj;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds the chain rule `∂a(z, k)/∂z ᵀ · grad_a` to `grad_z`.
+    pub fn add_chain(&self, grad_a: &[f64], k: f64, grad_z: &mut [f64]) {
+        let r = self.basis.len();
+        let proj: Vec<f64> = self
+            .basis
+            .iter()
+            .map(|col| crate::basis::dot(col, grad_a))
+            .collect();
+        for i in 0..self.terms {
+            let w = Self::weight(i + 1, k);
+            for q in 0..r {
+                grad_z[i * r + q] += w * proj[q];
+            }
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! The planning objective as a nonlinear program over the path unknowns `z`:
+//!
+//! `J(z) = S_β(U(a(z, k₀)), …, U(a(z, k_K))) + w · mean_j U(a(z, k_j))`
+//!
+//! where `S_β(u) = u_max + ln Σ exp(β (u_j − u_max)) / β` is the log-sum-exp smoothed maximum
+//! (an upper bound on `max u` by at most `ln(K+1)/β`) and `w ≥ 0` weighs the mean energy along
+//! the path (see the README: it makes the shapes away from the maximum equilibria too).
+//! With tracking targets `x̄_j` set (the equilibria the controlled end's poses produce, see
+//! [`crate::planner::Planner`]), `J` also has `(w_eq/2) · Σ_j mean_b |x_b(a(z,k_j)) − x̄_jb|²`,
+//! which pulls every sampled shape onto the equilibrium its own end pose gives.
+//! The path constraints (obstacles, self-contact, nonlinear fixed conditions) hold at every
+//! interior sample `k_j`: each block's rows are repeated per sample. Energies are dimensionless
+//! (`Rf/L`), positions in units of `L`.
+
+use crate::constraints::{Adjoint, Constraint};
+use crate::energy::Objective;
+use crate::kinematics::Shape;
+use crate::model::Model;
+use crate::optim::{Nlp, Sense};
+use crate::path::DeformationPath;
+
+/// The minimax path problem.
+#[derive(Debug)]
+pub struct MinimaxProblem {
+    /// Rod model.
+    pub model: Model,
+    /// The path.
+    pub path: DeformationPath,
+    /// Sampled path parameters (including 0 and 1).
+    pub ks: Vec<f64>,
+    /// Constraint blocks that hold at every interior sample.
+    pub blocks: Vec<Box<dyn Constraint>>,
+    /// Smoothing sharpness `β` (dimensionless energy⁻¹).
+    pub beta: f64,
+    /// Weight of the mean energy.
+    pub mean_weight: f64,
+    /// Energy minimised.
+    pub objective: Objective,
+    /// Weight of the equilibrium-tracking term.
+    pub track_weight: f64,
+    /// Tracking targets: boundary positions (dimensionless) per sample, when set.
+    pub targets: Option<Vec<Vec<[f64; 3]>>>,
+    interior: Vec<usize>,
+    offsets: Vec<usize>,
+    senses: Vec<Sense>,
+    a: Vec<Vec<f64>>,
+    shapes: Vec<Shape>,
+    u: Vec<f64>,
+    gu: Vec<Vec<f64>>,
+    weights: Vec<f64>,
+    adj: Adjoint,
+    ga: Vec<f64>,
+}
+
+impl MinimaxProblem {
+    /// Assembles the problem; constraints are enforced at samples with `0 < k < 1`.
+    pub fn new(
+        model: Model,
+        path: DeformationPath,
+        ks: Vec<f64>,
+        blocks: Vec<Box<dyn Constraint>>,
+        objective: Objective,
+    ) -> Self {
+        let interior: Vec<usize> = (0..ks.len())
+            .filter(|&j| ks[j] > 0.0 && ks[j] < 1.0)
+            .collect();
+        let mut offsets = vec![0];
+        let mut block_senses = Vec::new();
+        for b in &blocks {
+            for i in 0..b.rows() {
+                block_senses.push(b.sense(i));
+            }
+            offsets.push(offsets.last().unwrap() + b.rows());
+        }
+        let senses = interior
+            .iter()
+            .flat_map(|_| block_senses.iter().copied())
+            .collect();
+        let n = path.n();
+        let nk = ks.len();
+        let adj = Adjoint::new(&model);
+        MinimaxProblem {
+            model,
+            path,
+            ks,
+            blocks,
+            beta: 1.0,
+            mean_weight: 0.0,
+            objective,
+            track_weight: 0.0,
+            targets: None,
+            interior,
+            offsets,
+            senses,
+            a: vec![vec![0.0; n]; nk],
+            shapes: vec![Shape::default(); nk],
+            u: vec![0.0; nk],
+            gu: vec![vec![0.0; n]; nk],
+            weights: vec![0.0; nk],
+            adj,
+            ga: vec![0.0; n],
+        }
+    }
+
+    /// Rows per interior sample.
+    pub fn rows_per_sample(&self) -> usize {
+        *self.offsets.last().unwrap()
+    }
+
+    /// Sampled energies at the last evaluated point (dimensionless).
+    pub fn energies(&self) -> &[f64] {
+        &self.u
+    }
+
+    /// Sampled shapes' coefficients at the last evaluated point.
+    pub fn sampled(&self) -> &[Vec<f64>] {
+        &self.a
+    }
+
+    /// Index of the interior sample that row `i` belongs to, and the block.
+    pub fn row_owner(&self, i: usize) -> (usize, usize) {
+        let per = self.rows_per_sample();
+        let j = self.interior[i / per];
+        let r = i % per;
+        let b = self.offsets.partition_point(|&o| o <= r) - 1;
+        (j, b)
+    }
+}
+
+impl MinimaxProblem {
+    /// The tracking term at the last evaluated point.
+    pub fn tracking(&self) -> f64 {
+        let Some(t) = &self.targets else { return 0.0 };
+        let mut sum = 0.0;
+        for (sh, tj) in self.shapes.iter().zip(t) {
+            let nb = tj.len() as f64;
+            for (x, xb) in sh.positions.iter().zip(tj) {
+                sum += ((x[0] - xb[0]).powi(2) + (x[1] - xb[1]).powi(2) + (x[2] - xb[2]).powi(2))
+                    / nb;
+            }
+        }
+        0.5 * self.track_weight * sum
+    }
+}
+
+/// `S_β(u)` and its weights `∂S/∂u_j` (a softmax).
+pub fn smoothed_max(u: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
+    let umax = u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let mut sum = 0.0;
+    for (w, &uj) in weights.iter_mut().zip(u) {
+        *w = (beta * (uj - umax)).exp();
+        sum += *w;
+    }
+    for w in weights.iter_mut() {
+        *w /= sum;
+    }
+    umax + sum.ln() / beta
+}
+
+impl Nlp for MinimaxProblem {
+    fn n(&self) -> usize {
+        self.path.n_vars()
+    }
+    fn m(&self) -> usize {
+        self.senses.len()
+    }
+    fn sense(&self, i: usize) -> Sense {
+        self.senses[i]
+    }
+    fn values(&mut self, z: &[f64], c: &mut [f64]) -> f64 {
+        let per = self.rows_per_sample();
+        let mut row = 0;
+        for (j, &k) in self.ks.iter().enumerate() {
+            self.path.shape_at(z, k, &mut self.a[j]);
+            self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
+            self.gu[j].iter_mut().for_each(|g| *g = 0.0);
+            let t = self
+                .model
+                .energy(&self.a[j], &self.shapes[j], self.objective, Some(&mut self.gu[j]));
+            self.u[j] = match self.objective {
+                Objective::Internal => t.internal(),
+                Objective::Potential => t.potential(),
+            };
+            if k > 0.0 && k < 1.0 {
+                for (b, blk) in self.blocks.iter().enumerate() {
+                    blk.values(
+                        &self.model,
+                        &self.a[j],
+                        &self.shapes[j],
+                        &mut c[row + self.offsets[b]..row + self.offsets[b + 1]],
+                    );
+                }
+                row += per;
+            }
+        }
+        let s = smoothed_max(&self.u, self.beta, &mut self.weights);
+        let mean = self.u.iter().sum::<f64>() / self.u.len() as f64;
+        s + self.mean_weight * mean + self.tracking()
+    }
+    fn gradient(&mut self, z: &[f64], y: &[f64], g: &mut [f64]) {
+        let _ = z;
+        g.iter_mut().for_each(|v| *v = 0.0);
+        let per = self.rows_per_sample();
+        let nk = self.ks.len() as f64;
+        let mut row = 0;
+        for (j, &k) in self.ks.iter().enumerate() {
+            let wj = self.weights[j] + self.mean_weight / nk;
+            for (ga, gu) in self.ga.iter_mut().zip(&self.gu[j]) {
+                *ga = wj * gu;
+            }
+            if k > 0.0 && k < 1.0 {
+                let yj = &y[row..row + per];
+                let tracked = self.targets.is_some() && self.track_weight > 0.0;
+                if tracked || yj.iter().any(|v| *v != 0.0) {
+                    self.adj.clear();
+                    for (b, blk) in self.blocks.iter().enumerate() {
+                        let w = &yj[self.offsets[b]..self.offsets[b + 1]];
+                        if w.iter().any(|v| *v != 0.0) {
+                            blk.add_gradient(
+                                &self.model,
+                                &self.a[j],
+                                &self.shapes[j],
+                                w,
+                                &mut self.adj,
+                            );
+                        }
+                    }
+                    if let (true, Some(t)) = (tracked, &self.targets) {
+                        let tj = &t[j];
+                        let wt = self.track_weight / tj.len() as f64;
+                        for (b, (x, xb)) in self.shapes[j].positions.iter().zip(tj).enumerate() {
+                            self.adj
+                                .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                        }
+                    }
+                    self.adj.finish(&self.model, &self.shapes[j], &mut self.ga);
+                }
+                row += per;
+            }
+            if k > 0.0 && k < 1.0 {
+                self.path.add_chain(&self.ga, k, g);
+            }
+        }
+    }
+}

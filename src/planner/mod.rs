@@ -1,0 +1,625 @@
+//! Deformation path planning (paper §7): the minimax-energy path in coefficient space between
+//! two static shapes, verified on a finer grid and replayed by the controlled end alone.
+//!
+//! [`Planner::from_case`] solves the start and goal shapes; [`Planner::run`] optimises, verifies
+//! and replays, telling a [`PlanObserver`] every shape it computes.
+
+pub mod endpoints;
+pub mod minimax;
+pub mod observer;
+pub mod replay;
+pub mod spec;
+pub mod verify;
+
+use crate::case::Case;
+use crate::constraints::{
+    Angle, Constraint, LinearConstraint, ObstacleConstraint, OrientationConstraint,
+    PositionConstraint,
+};
+use crate::error::Error;
+use crate::kinematics::Shape;
+use crate::obstacle::Obstacle;
+use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
+use crate::path::DeformationPath;
+use crate::problem::StaticProblem;
+use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
+use endpoints::EndPose;
+use minimax::MinimaxProblem;
+use observer::{PathKind, PlanObserver, Progress, ShapeRecord};
+use replay::{Replay, ReplayOptions, replay};
+use serde::Serialize;
+use spec::{End, PlanOptions};
+use std::sync::Arc;
+use verify::{Verification, fine_model, verify};
+
+/// A planning problem ready to run: the held end's conditions, the obstacles, and the two
+/// solved end shapes.
+#[derive(Clone, Debug)]
+pub struct Planner {
+    /// The case's static problem (fixed conditions, obstacles, self-contact).
+    pub base: StaticProblem,
+    /// Obstacles.
+    pub obstacles: Vec<Arc<Obstacle>>,
+    /// Settings.
+    pub options: PlanOptions,
+    /// Static solver settings (endpoints and replay).
+    pub static_options: StaticOptions,
+    /// The start shape's solve.
+    pub start: StaticSolution,
+    /// The goal shape's solve.
+    pub goal: StaticSolution,
+    /// Rows of the fixed conditions that are linear in the coefficients.
+    pub linear_rows: Vec<Vec<f64>>,
+}
+
+/// How a plan ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanStatus {
+    /// The optimiser converged and the verification grid is collision-free.
+    Planned,
+    /// The verification grid finds a collision (e.g. tunnelling between samples).
+    Collision,
+    /// The optimiser did not converge (the path may still be collision-free).
+    NotConverged,
+}
+
+/// Summary of one optimiser start.
+#[derive(Clone, Debug, Serialize)]
+pub struct StartSummary {
+    /// Start index.
+    pub start: usize,
+    /// Final optimiser status.
+    pub status: AlStatus,
+    /// Largest sampled energy (case units).
+    pub sampled_u_max: f64,
+    /// Constraint violation (dimensionless).
+    pub violation: f64,
+    /// Objective evaluations.
+    pub evaluations: usize,
+}
+
+/// The outcome of [`Planner::run`].
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanResult {
+    /// Overall status.
+    pub status: PlanStatus,
+    /// Optimiser status of the chosen start.
+    pub optimiser: AlStatus,
+    /// True `U_max` of the plan on the verification grid (case units).
+    pub u_max: f64,
+    /// `k` where it occurs.
+    pub k_at_u_max: f64,
+    /// `U_max` of the straight-line path `c = 0` (case units).
+    pub u_max_straight: f64,
+    /// Smallest obstacle clearance on the verification grid, optimal path (case units).
+    pub min_clearance: Option<f64>,
+    /// Smallest obstacle clearance of the straight-line path (case units).
+    pub min_clearance_straight: Option<f64>,
+    /// Largest violation of the optimiser's sampled constraints (dimensionless).
+    pub violation: f64,
+    /// Verification details of the plan.
+    pub verification: Verification,
+    /// Every start.
+    pub starts: Vec<StartSummary>,
+    /// Path vectors `cᵢ` (coefficient space).
+    pub path: Vec<Vec<f64>>,
+    /// The unknowns `z`.
+    #[serde(skip)]
+    pub z: Vec<f64>,
+    /// Feasibility replay.
+    pub replay: Replay,
+    /// Seconds spent planning (optimise + verify) and replaying.
+    pub timing_s: Timing,
+}
+
+/// Wall-clock times.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Timing {
+    /// Start and goal solves.
+    pub endpoints: f64,
+    /// Optimisation and verification.
+    pub plan: f64,
+    /// Replay.
+    pub replay: f64,
+}
+
+/// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
+pub fn clearance(p: &StaticProblem, positions: &[[f64; 3]]) -> Option<f64> {
+    let l = p.model.rod.length;
+    let r = p.model.rod.radius;
+    let mut best: Option<f64> = None;
+    for con in &p.constraints {
+        if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
+            for x in positions {
+                let (d, _) = ob.obstacle.signed_distance(x.map(|v| v * l));
+                best = Some(best.map_or(d - r, |b: f64| b.min(d - r)));
+            }
+        }
+    }
+    best
+}
+
+/// Splits the case's constraints into linear rows (eliminated from the path), blocks that hold
+/// at every sampled `k`, and nothing (the fixed base's own position, which is constant).
+fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Box<dyn Constraint>>) {
+    let model = &p.model;
+    let n = model.n();
+    let mut linear = Vec::new();
+    let mut blocks: Vec<Box<dyn Constraint>> = Vec::new();
+    for con in &p.constraints {
+        let any = con.as_any();
+        if let Some(oc) = any.downcast_ref::<OrientationConstraint>()
+            && oc.rows.iter().all(|(a, _)| matches!(a, Angle::Field(_)))
+        {
+            for &(ang, _) in &oc.rows {
+                let mut row = vec![0.0; n];
+                for &(f, w) in ang.terms() {
+                    let off = model.layout.offset(f).expect("validated field");
+                    for (i, e) in oc.e.iter().enumerate() {
+                        row[off + i] += w * e;
+                    }
+                }
+                linear.push(row);
+            }
+        } else if let Some(lc) = any.downcast_ref::<LinearConstraint>() {
+            for (r, _) in &lc.rows {
+                let mut row = vec![0.0; n];
+                for &(j, c) in r {
+                    row[j] += c;
+                }
+                linear.push(row);
+            }
+        } else if let Some(ob) = any.downcast_ref::<ObstacleConstraint>() {
+            let mut o = ob.clone();
+            o.clearance += safety;
+            blocks.push(Box::new(o));
+        } else if let Some(pc) = any.downcast_ref::<PositionConstraint>()
+            && pc.boundary == 0
+            && !model.layout.free_base
+        {
+            // x(0) is the fixed base: constant along every path.
+        } else {
+            blocks.push(con.clone());
+        }
+    }
+    (linear, blocks)
+}
+
+fn end_shape(
+    case: &Case,
+    field: &str,
+    end: &End,
+    opts: &StaticOptions,
+) -> Result<StaticSolution, Error> {
+    let base = &case.problem;
+    let pose = EndPose {
+        position: end.position.clone(),
+        angles: end
+            .angles
+            .iter()
+            .map(|&(f, v)| (Angle::Field(f), v))
+            .collect(),
+    };
+    let mut p = pose.problem(base);
+    let sol = if end.position.is_empty() && end.angles.is_empty() {
+        let a = end.shape.clone().expect("validated: shape or pose");
+        let (energy, viol, reactions, kkt) = crate::statics::evaluate_shape(&mut p, &a);
+        StaticSolution {
+            energy_scaled: energy.scaled(1.0 / base.model.rod.energy_unit()),
+            energy,
+            status: if viol <= 1e-6 {
+                SolveStatus::Converged
+            } else {
+                SolveStatus::Infeasible
+            },
+            lambda: vec![0.0; crate::optim::Nlp::m(&p)],
+            max_violation: viol,
+            kkt_residual: kkt,
+            reactions,
+            stable: None,
+            min_reduced_eigenvalue: None,
+            outer_iterations: 0,
+            evaluations: 1,
+            a,
+        }
+    } else {
+        let a0 = end.shape.clone().unwrap_or_else(|| case.initial.clone());
+        solve_static(&mut p, &a0, opts)
+    };
+    if sol.status != SolveStatus::Converged {
+        return Err(Error::invalid(
+            &case.path,
+            format!("plan.{field}"),
+            if end.position.is_empty() && end.angles.is_empty() {
+                format!(
+                    "the given shape violates the case's constraints or obstacles by {:.3e} (units of L)",
+                    sol.max_violation
+                )
+            } else {
+                format!(
+                    "no static shape reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L)",
+                    sol.status, sol.max_violation
+                )
+            },
+        ));
+    }
+    Ok(sol)
+}
+
+/// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
+fn noise(seed: u64, n: usize) -> Vec<f64> {
+    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            let v = s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+            2.0 * (v as f64 / (1u64 << 53) as f64) - 1.0
+        })
+        .collect()
+}
+
+struct StartRun {
+    z: Vec<f64>,
+    status: AlStatus,
+    violation: f64,
+    sampled_max: f64,
+    evaluations: usize,
+    progress: Vec<(Progress, Vec<f64>)>,
+}
+
+impl Planner {
+    /// Validates the case's `plan` section and solves the start and goal shapes.
+    pub fn from_case(case: &Case) -> Result<Planner, Error> {
+        let options = spec::plan_options(case)?;
+        let static_options = case.options;
+        let start = end_shape(case, "start", &options.start, &static_options)?;
+        let goal = end_shape(case, "goal", &options.goal, &static_options)?;
+        let (linear_rows, _) = classify(&case.problem, 0.0);
+        Ok(Planner {
+            base: case.problem.clone(),
+            obstacles: case.obstacles.clone(),
+            options,
+            static_options,
+            start,
+            goal,
+            linear_rows,
+        })
+    }
+
+    /// The straight-line path `c = 0` and the path's unknowns' count.
+    pub fn path(&self) -> DeformationPath {
+        DeformationPath::new(
+            self.start.a.clone(),
+            self.goal.a.clone(),
+            self.options.terms,
+            &self.linear_rows,
+        )
+    }
+
+    /// The optimiser's problem with `blocks` from the case and the safety margin.
+    pub fn minimax_problem(&self) -> MinimaxProblem {
+        let (_, blocks) = classify(&self.base, self.options.safety);
+        let nk = self.options.k_samples;
+        let ks = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
+        let mut p = MinimaxProblem::new(
+            self.base.model.clone(),
+            self.path(),
+            ks,
+            blocks,
+            self.base.objective,
+        );
+        p.mean_weight = self.options.mean_weight;
+        p
+    }
+
+    fn optimise_from(&self, start: usize, z0: Vec<f64>) -> StartRun {
+        let mut p = self.minimax_problem();
+        let unit = self.base.model.rod.energy_unit();
+        let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
+        // Energy scale of the sharpness: the straight path's largest sampled energy.
+        let zero = vec![0.0; p.path.n_vars()];
+        crate::optim::Nlp::values(&mut p, &zero, &mut c);
+        let u_ref = p
+            .energies()
+            .iter()
+            .copied()
+            .fold(0.0_f64, f64::max)
+            .max(1e-3);
+        let mut z = z0;
+        let mut lambda: Option<Vec<f64>> = None;
+        let mut status = AlStatus::IterationLimit;
+        let mut violation = f64::INFINITY;
+        let mut evaluations = 0;
+        let mut progress = Vec::new();
+        let al = AlOptions {
+            feasibility_tol: 1e-6,
+            optimality_tol: 1e-5,
+            rho_initial: 1e2,
+            rho_max: 1e8,
+            max_outer: 30,
+            max_inner: 300,
+            active_tol: 1e-7,
+        };
+        for (stage, &b) in self.options.sharpness.iter().enumerate() {
+            p.beta = b / u_ref;
+            let out = {
+                let pp = &mut p;
+                let progress = &mut progress;
+                let mut cbuf = vec![0.0; crate::optim::Nlp::m(pp)];
+                let ks = pp.ks.clone();
+                let beta = pp.beta;
+                let mw = pp.mean_weight;
+                // The observer needs the sampled energies at the iterate: re-evaluate a cheap
+                // copy of the problem.
+                let mut probe = self.minimax_problem();
+                probe.beta = beta;
+                probe.mean_weight = mw;
+                augmented_lagrangian_observed(
+                    pp,
+                    &mut z,
+                    lambda.as_deref(),
+                    al,
+                    &mut |it| {
+                        let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
+                        let u = probe.energies();
+                        let (j, &umax) = u
+                            .iter()
+                            .enumerate()
+                            .max_by(|a, b| a.1.total_cmp(b.1))
+                            .expect("samples");
+                        let mean = u.iter().sum::<f64>() / u.len() as f64;
+                        progress.push((
+                            Progress {
+                                start,
+                                stage,
+                                outer: it.outer,
+                                smoothed_max: (f - mw * mean) * unit,
+                                sampled_max: umax * unit,
+                                k_worst: ks[j],
+                                violation: it.violation,
+                                rho: it.rho,
+                            },
+                            probe.sampled()[j].clone(),
+                        ));
+                    },
+                )
+            };
+            evaluations += out.evaluations;
+            status = out.status;
+            violation = out.max_violation;
+            lambda = Some(out.lambda);
+            if status == AlStatus::NumericalFailure {
+                break;
+            }
+        }
+        // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
+        // produces (see the README for why the paper's objective alone does not).
+        if status != AlStatus::NumericalFailure && self.options.track_weight > 0.0 {
+            p.track_weight = self.options.track_weight;
+            // Targets keep the optimiser's safety margin from obstacles.
+            let mut inflated = self.base.clone();
+            for con in inflated.constraints.iter_mut() {
+                if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
+                    let mut o = ob.clone();
+                    o.clearance += self.options.safety;
+                    *con = Box::new(o);
+                }
+            }
+            for _ in 0..self.options.track_rounds {
+                let targets = replay::equilibria(
+                    &inflated,
+                    &self.start,
+                    &p.path,
+                    &z,
+                    &p.ks,
+                    &self.static_options,
+                );
+                p.targets = Some(targets);
+                let out = augmented_lagrangian_observed(&mut p, &mut z, lambda.as_deref(), al, &mut |_| {});
+                evaluations += out.evaluations;
+                status = out.status;
+                violation = out.max_violation;
+                lambda = Some(out.lambda);
+                if status == AlStatus::NumericalFailure {
+                    break;
+                }
+            }
+        }
+        crate::optim::Nlp::values(&mut p, &z, &mut c);
+        let sampled_max = p.energies().iter().copied().fold(f64::NEG_INFINITY, f64::max) * unit;
+        StartRun {
+            z,
+            status,
+            violation,
+            sampled_max,
+            evaluations,
+            progress,
+        }
+    }
+
+    /// Optimises, verifies and replays the plan.
+    pub fn run(&self, observer: &mut dyn PlanObserver) -> PlanResult {
+        let model = &self.base.model;
+        let unit = model.rod.energy_unit();
+        observer.begin(model);
+        observer.phase("endpoints");
+        for (k, sol) in [(0.0, &self.start), (1.0, &self.goal)] {
+            let sh = model.evaluate(&sol.a);
+            observer.shape(
+                model,
+                &ShapeRecord {
+                    kind: PathKind::Endpoint,
+                    k,
+                    a: &sol.a,
+                    energy: sol.energy,
+                    clearance: clearance(&self.base, &sh.positions),
+                    deviation: None,
+                    stable: sol.stable,
+                    reactions: &sol.reactions,
+                },
+            );
+        }
+        let t0 = std::time::Instant::now();
+        let path = self.path();
+        let nv = path.n_vars();
+        let fine = fine_model(model, self.options.verify_s, 4);
+        let straight = verify(
+            &fine,
+            &path,
+            &vec![0.0; nv],
+            self.options.verify_k,
+            &self.obstacles,
+            self.base.objective,
+        );
+        {
+            let mut a = vec![0.0; path.n()];
+            let mut sh = Shape::default();
+            let steps = self.options.replay_steps;
+            for i in 0..=steps {
+                let k = i as f64 / steps as f64;
+                path.shape_at(&vec![0.0; nv], k, &mut a);
+                model.evaluate_into(&a, &mut sh);
+                let e = model.energy(&a, &sh, self.base.objective, None).scaled(unit);
+                observer.shape(
+                    model,
+                    &ShapeRecord {
+                        kind: PathKind::Straight,
+                        k,
+                        a: &a,
+                        energy: e,
+                        clearance: clearance(&self.base, &sh.positions),
+                        deviation: None,
+                        stable: None,
+                        reactions: &[],
+                    },
+                );
+            }
+        }
+
+        observer.phase("optimise");
+        let starts: Vec<Vec<f64>> = (0..self.options.starts)
+            .map(|s| {
+                let amp = if s == 0 { 1e-2 } else { self.options.spread };
+                noise(self.options.seed.wrapping_add(s as u64), nv)
+                    .into_iter()
+                    .map(|v| amp * v)
+                    .collect()
+            })
+            .collect();
+        let runs: Vec<StartRun> = if starts.len() == 1 {
+            vec![self.optimise_from(0, starts[0].clone())]
+        } else {
+            let workers = std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(starts.len());
+            let mut results: Vec<Option<StartRun>> = (0..starts.len()).map(|_| None).collect();
+            std::thread::scope(|sc| {
+                let chunks: Vec<Vec<usize>> = (0..workers)
+                    .map(|w| (w..starts.len()).step_by(workers).collect())
+                    .collect();
+                let handles: Vec<_> = chunks
+                    .into_iter()
+                    .map(|idx| {
+                        let starts = &starts;
+                        sc.spawn(move || {
+                            idx.into_iter()
+                                .map(|i| (i, self.optimise_from(i, starts[i].clone())))
+                                .collect::<Vec<_>>()
+                        })
+                    })
+                    .collect();
+                for h in handles {
+                    for (i, r) in h.join().expect("optimiser thread") {
+                        results[i] = Some(r);
+                    }
+                }
+            });
+            results.into_iter().map(|r| r.expect("every start ran")).collect()
+        };
+        for r in &runs {
+            for (pr, worst) in &r.progress {
+                observer.progress(model, pr, worst);
+            }
+        }
+        let feasible = |r: &StartRun| r.violation <= 1e-6;
+        let best = runs
+            .iter()
+            .enumerate()
+            .min_by(|(_, a), (_, b)| {
+                feasible(b)
+                    .cmp(&feasible(a))
+                    .then(a.sampled_max.total_cmp(&b.sampled_max))
+            })
+            .map(|(i, _)| i)
+            .expect("at least one start");
+        let chosen = &runs[best];
+        observer.phase("verify");
+        let ver = verify(
+            &fine,
+            &path,
+            &chosen.z,
+            self.options.verify_k,
+            &self.obstacles,
+            self.base.objective,
+        );
+        let t_plan = t0.elapsed().as_secs_f64();
+
+        observer.phase("replay");
+        let t1 = std::time::Instant::now();
+        let rep = replay(
+            &self.base,
+            &self.start,
+            &path,
+            &chosen.z,
+            ReplayOptions {
+                steps: self.options.replay_steps,
+                refinements: self.options.refinements,
+                tolerance: self.options.tolerance,
+            },
+            &self.static_options,
+            observer,
+        );
+        let t_replay = t1.elapsed().as_secs_f64();
+        let tol = 1e-6 * model.rod.length;
+        let status = if !ver.collision_free(tol) {
+            PlanStatus::Collision
+        } else if chosen.status != AlStatus::Converged {
+            PlanStatus::NotConverged
+        } else {
+            PlanStatus::Planned
+        };
+        PlanResult {
+            status,
+            optimiser: chosen.status,
+            u_max: ver.u_max,
+            k_at_u_max: ver.k_at_u_max,
+            u_max_straight: straight.u_max,
+            min_clearance: ver.min_clearance,
+            min_clearance_straight: straight.min_clearance,
+            violation: chosen.violation,
+            starts: runs
+                .iter()
+                .enumerate()
+                .map(|(i, r)| StartSummary {
+                    start: i,
+                    status: r.status,
+                    sampled_u_max: r.sampled_max,
+                    violation: r.violation,
+                    evaluations: r.evaluations,
+                })
+                .collect(),
+            path: path.c_vectors(&chosen.z),
+            z: chosen.z.clone(),
+            verification: ver,
+            replay: rep,
+            timing_s: Timing {
+                endpoints: 0.0,
+                plan: t_plan,
+                replay: t_replay,
+            },
+        }
+    }
+}

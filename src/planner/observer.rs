@@ -1,0 +1,82 @@
+//! What the planner tells the outside world while it works: every shape it computes and the
+//! optimiser's progress. The library prints nothing; the CLI's progress line and the MCAP log
+//! are observers.
+
+use crate::energy::EnergyTerms;
+use crate::model::Model;
+use crate::statics::Reaction;
+
+/// Which computation a shape belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PathKind {
+    /// The start and goal static solves.
+    Endpoint,
+    /// The straight-line path `c = 0`.
+    Straight,
+    /// The worst shape of an optimiser iterate.
+    Iterate,
+    /// The optimal path on the verification grid.
+    Optimal,
+    /// The feasibility replay.
+    Feasible,
+}
+
+/// One computed shape.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeRecord<'a> {
+    /// Which computation produced it.
+    pub kind: PathKind,
+    /// Path parameter `k ∈ [0, 1]`.
+    pub k: f64,
+    /// Ritz coefficients.
+    pub a: &'a [f64],
+    /// Energy terms in the case's units.
+    pub energy: EnergyTerms,
+    /// Smallest clearance to any obstacle (case units; `None` without obstacles).
+    pub clearance: Option<f64>,
+    /// Distance to the optimal path's shape at the same `k` (replay only, case units).
+    pub deviation: Option<f64>,
+    /// Stability verdict (replay only).
+    pub stable: Option<bool>,
+    /// Reactions (replay only).
+    pub reactions: &'a [Reaction],
+}
+
+/// Progress of the minimax optimiser after one outer iteration.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Index of the start (multi-start).
+    pub start: usize,
+    /// Continuation stage (sharpness index).
+    pub stage: usize,
+    /// Outer iteration within the stage.
+    pub outer: usize,
+    /// Smoothed maximum (case units).
+    pub smoothed_max: f64,
+    /// True maximum over the sampled `k` (case units).
+    pub sampled_max: f64,
+    /// `k` of the sampled maximum.
+    pub k_worst: f64,
+    /// Constraint violation (dimensionless).
+    pub violation: f64,
+    /// Penalty parameter.
+    pub rho: f64,
+}
+
+/// Receives what the planner computes. All methods default to doing nothing.
+pub trait PlanObserver {
+    /// Called once before anything else with the model every shape refers to.
+    fn begin(&mut self, _model: &Model) {}
+    /// A phase starts (`"endpoints"`, `"optimise"`, `"verify"`, `"replay"`).
+    fn phase(&mut self, _name: &str) {}
+    /// A shape was computed.
+    fn shape(&mut self, _model: &Model, _record: &ShapeRecord) {}
+    /// The optimiser finished an outer iteration; `worst` is the shape at `k_worst`.
+    fn progress(&mut self, _model: &Model, _p: &Progress, _worst: &[f64]) {}
+}
+
+/// An observer that ignores everything.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Silent;
+
+impl PlanObserver for Silent {}

@@ -1,0 +1,274 @@
+//! Feasibility replay (paper §7.2): drive the rod by the optimal path's controlled end pose
+//! alone, solving the static shape at each `k` warm-started from the previous one, and compare
+//! the result with the optimal path.
+//!
+//! Where consecutive replayed shapes jump much more than the optimal path moves, the step is
+//! bisected (up to a limit); a jump that survives every bisection is a snap-through: the end
+//! pose alone cannot follow the path there.
+
+use super::endpoints::EndPose;
+use super::observer::{PathKind, PlanObserver, ShapeRecord};
+use crate::kinematics::Shape;
+use crate::path::DeformationPath;
+use crate::problem::StaticProblem;
+use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static_warm};
+use serde::Serialize;
+
+/// One replayed shape.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReplayStep {
+    /// Path parameter.
+    pub k: f64,
+    /// `d(k) = max_s |x_opt(s,k) − x_feas(s,k)|` (case units).
+    pub deviation: f64,
+    /// Energy of the optimal path's shape (case units).
+    pub u_optimal: f64,
+    /// Energy of the replayed shape (case units).
+    pub u_feasible: f64,
+    /// The static solve converged.
+    pub converged: bool,
+    /// Stability of the replayed shape.
+    pub stable: Option<bool>,
+    /// Constraint violation of the solve (dimensionless).
+    pub violation: f64,
+}
+
+/// Summary of a replay.
+#[derive(Clone, Debug, Serialize)]
+pub struct Replay {
+    /// `max_k d(k) / L`.
+    pub max_deviation_over_l: f64,
+    /// `k` of that maximum.
+    pub k_at_max_deviation: f64,
+    /// Largest energy along the feasible path (case units).
+    pub u_max: f64,
+    /// Every replayed shape is stable.
+    pub all_stable: bool,
+    /// Every static solve converged.
+    pub all_converged: bool,
+    /// `k` where the replayed shape jumps even after refinement (snap-through).
+    pub snaps: Vec<f64>,
+    /// Tolerance of the verdict (fraction of `L`).
+    pub tolerance: f64,
+    /// `max d/L ≤ tolerance`, every solve converged and no snap-through.
+    pub coincide: bool,
+    /// Deviation at `k = 0` over `L` (the replay reproduces the start).
+    pub start_deviation_over_l: f64,
+    /// Deviation at `k = 1` over `L` (the replay reproduces the goal).
+    pub end_deviation_over_l: f64,
+    /// Every step, in increasing `k`.
+    pub steps: Vec<ReplayStep>,
+}
+
+/// Replay settings.
+#[derive(Clone, Copy, Debug)]
+pub struct ReplayOptions {
+    /// Uniform steps in `k`.
+    pub steps: usize,
+    /// Bisections allowed per step.
+    pub refinements: usize,
+    /// Coincidence tolerance (fraction of `L`).
+    pub tolerance: f64,
+}
+
+struct State {
+    k: f64,
+    sol: StaticSolution,
+    positions: Vec<[f64; 3]>,
+}
+
+/// Largest distance between corresponding boundary points (dimensionless).
+fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| {
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Replays `path(z)` from `start`, the static solve of its start shape (an equilibrium of
+/// `base` plus the start pose, whose multipliers warm-start the first step).
+pub fn replay(
+    base: &StaticProblem,
+    start: &StaticSolution,
+    path: &DeformationPath,
+    z: &[f64],
+    opts: ReplayOptions,
+    static_opts: &StaticOptions,
+    observer: &mut dyn PlanObserver,
+) -> Replay {
+    let model = &base.model;
+    let l = model.rod.length;
+    let unit = model.rod.energy_unit();
+    let mut shape = Shape::default();
+    let mut a = vec![0.0; path.n()];
+    let mut optimal_at = |k: f64| -> (Vec<f64>, Vec<[f64; 3]>, f64) {
+        path.shape_at(z, k, &mut a);
+        model.evaluate_into(&a, &mut shape);
+        let u = model
+            .energy(&a, &shape, base.objective, None)
+            .scaled(unit);
+        let u = match base.objective {
+            crate::energy::Objective::Internal => u.internal(),
+            crate::energy::Objective::Potential => u.potential(),
+        };
+        (a.clone(), shape.positions.clone(), u)
+    };
+    let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
+        let pose = EndPose::of(model, &target.0, &target.1);
+        let mut p = pose.problem(base);
+        let sol = if from.sol.lambda.len() == crate::optim::Nlp::m(&p) {
+            solve_static_warm(&mut p, &from.sol.a, &from.sol.lambda, static_opts)
+        } else {
+            crate::statics::solve_static(&mut p, &from.sol.a, static_opts)
+        };
+        let positions = model.evaluate(&sol.a).positions;
+        State { k, sol, positions }
+    };
+    // k = 0: solve from the start shape itself.
+    let first_target = optimal_at(0.0);
+    let seed = State {
+        k: 0.0,
+        sol: start.clone(),
+        positions: first_target.1.clone(),
+    };
+    let mut steps: Vec<ReplayStep> = Vec::new();
+    let mut snaps = Vec::new();
+    let record = |st: &State,
+                      target: &(Vec<f64>, Vec<[f64; 3]>, f64),
+                      steps: &mut Vec<ReplayStep>,
+                      observer: &mut dyn PlanObserver| {
+        let d = max_distance(&st.positions, &target.1) * l;
+        steps.push(ReplayStep {
+            k: st.k,
+            deviation: d,
+            u_optimal: target.2,
+            u_feasible: match base.objective {
+                crate::energy::Objective::Internal => st.sol.energy.internal(),
+                crate::energy::Objective::Potential => st.sol.energy.potential(),
+            },
+            converged: st.sol.status == SolveStatus::Converged,
+            stable: st.sol.stable,
+            violation: st.sol.max_violation,
+        });
+        let clearance = super::clearance(base, &st.positions);
+        let opt_terms = {
+            let mut sh = Shape::default();
+            model.evaluate_into(&target.0, &mut sh);
+            model.energy(&target.0, &sh, base.objective, None).scaled(unit)
+        };
+        observer.shape(
+            model,
+            &ShapeRecord {
+                kind: PathKind::Optimal,
+                k: st.k,
+                a: &target.0,
+                energy: opt_terms,
+                clearance: super::clearance(base, &target.1),
+                deviation: None,
+                stable: None,
+                reactions: &[],
+            },
+        );
+        observer.shape(
+            model,
+            &ShapeRecord {
+                kind: PathKind::Feasible,
+                k: st.k,
+                a: &st.sol.a,
+                energy: st.sol.energy,
+                clearance,
+                deviation: Some(d),
+                stable: st.sol.stable,
+                reactions: &st.sol.reactions,
+            },
+        );
+    };
+    let mut current = solve(0.0, &seed, &first_target);
+    record(&current, &first_target, &mut steps, observer);
+    for i in 1..=opts.steps {
+        let k_hi = i as f64 / opts.steps as f64;
+        // Advance from current.k to k_hi, bisecting where the replayed shape jumps.
+        let mut pending = vec![(k_hi, 0usize)];
+        while let Some((k, depth)) = pending.pop() {
+            let target = optimal_at(k);
+            let prev_target = optimal_at(current.k);
+            let next = solve(k, &current, &target);
+            let jump = max_distance(&next.positions, &current.positions);
+            let moved = max_distance(&target.1, &prev_target.1);
+            let jumped = jump > (3.0 * moved).max(0.02);
+            if jumped && depth < opts.refinements {
+                pending.push((k, depth + 1));
+                pending.push((0.5 * (current.k + k), depth + 1));
+                continue;
+            }
+            if jumped {
+                snaps.push(k);
+            }
+            record(&next, &target, &mut steps, observer);
+            current = next;
+        }
+    }
+    let (imax, dmax) = steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, s.deviation))
+        .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc });
+    let all_converged = steps.iter().all(|s| s.converged);
+    let all_stable = steps.iter().all(|s| s.stable != Some(false));
+    let max_dev = dmax / l;
+    Replay {
+        max_deviation_over_l: max_dev,
+        k_at_max_deviation: steps[imax].k,
+        u_max: steps
+            .iter()
+            .map(|s| s.u_feasible)
+            .fold(f64::NEG_INFINITY, f64::max),
+        all_stable,
+        all_converged,
+        coincide: max_dev <= opts.tolerance && all_converged && snaps.is_empty(),
+        snaps,
+        tolerance: opts.tolerance,
+        start_deviation_over_l: steps[0].deviation / l,
+        end_deviation_over_l: steps.last().map_or(0.0, |s| s.deviation / l),
+        steps,
+    }
+}
+
+/// Equilibria the controlled end's poses along `path(z)` produce at `ks` (increasing, from 0):
+/// one warm-started static solve per `k`, without refinement. Returns the boundary positions
+/// (dimensionless) of each, for the planner's tracking term.
+pub fn equilibria(
+    base: &StaticProblem,
+    start: &StaticSolution,
+    path: &DeformationPath,
+    z: &[f64],
+    ks: &[f64],
+    static_opts: &StaticOptions,
+) -> Vec<Vec<[f64; 3]>> {
+    let model = &base.model;
+    let opts = StaticOptions {
+        stability: false,
+        ..*static_opts
+    };
+    let mut a = vec![0.0; path.n()];
+    let mut shape = Shape::default();
+    let mut prev = start.clone();
+    ks.iter()
+        .map(|&k| {
+            path.shape_at(z, k, &mut a);
+            model.evaluate_into(&a, &mut shape);
+            let pose = EndPose::of(model, &a, &shape.positions);
+            let mut p = pose.problem(base);
+            let sol = if prev.lambda.len() == crate::optim::Nlp::m(&p) {
+                solve_static_warm(&mut p, &prev.a, &prev.lambda, &opts)
+            } else {
+                crate::statics::solve_static(&mut p, &prev.a, &opts)
+            };
+            let x = model.evaluate(&sol.a).positions;
+            prev = sol;
+            x
+        })
+        .collect()
+}

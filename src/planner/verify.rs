@@ -1,0 +1,133 @@
+//! Verification of a path on a grid of `(s, k)` the optimiser never saw: the true maximum
+//! energy and the worst clearance to every obstacle. A path that tunnels through an obstacle
+//! between the optimiser's samples shows up here as a negative clearance.
+
+use crate::energy::Objective;
+use crate::kinematics::Shape;
+use crate::model::{Discretisation, Model};
+use crate::obstacle::Obstacle;
+use crate::path::DeformationPath;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// The verification model: the case's rod with `s_intervals` uniform sample points as panel
+/// boundaries (a finer quadrature than the optimiser's as well).
+pub fn fine_model(model: &Model, s_intervals: usize, gauss_points: usize) -> Model {
+    let pts: Vec<f64> = (0..=s_intervals)
+        .map(|j| j as f64 / s_intervals as f64)
+        .collect();
+    Model::new(
+        model.rod.clone(),
+        model.layout,
+        Discretisation {
+            panels: s_intervals,
+            gauss_points,
+        },
+        model.base,
+        model.loads.clone(),
+        &pts,
+    )
+}
+
+/// Worst clearance to one obstacle.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObstacleClearance {
+    /// Obstacle name.
+    pub obstacle: String,
+    /// Smallest surface gap `d − r` (case units; negative = penetration).
+    pub clearance: f64,
+    /// Where along the path.
+    pub k: f64,
+    /// Where along the rod (case units).
+    pub s: f64,
+}
+
+/// Result of [`verify`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Verification {
+    /// Largest energy on the grid (case units).
+    pub u_max: f64,
+    /// `k` where it occurs.
+    pub k_at_u_max: f64,
+    /// Energy at every grid `k` (case units).
+    #[serde(skip)]
+    pub energies: Vec<f64>,
+    /// Grid `k`.
+    #[serde(skip)]
+    pub ks: Vec<f64>,
+    /// Per obstacle.
+    pub obstacles: Vec<ObstacleClearance>,
+    /// Smallest over obstacles (case units), `None` without obstacles.
+    pub min_clearance: Option<f64>,
+}
+
+impl Verification {
+    /// Whether no obstacle is penetrated (within `tol`, case units).
+    pub fn collision_free(&self, tol: f64) -> bool {
+        self.min_clearance.is_none_or(|c| c >= -tol)
+    }
+}
+
+/// Evaluates `path(z)` on `k_samples` uniform values of `k` with the fine model.
+pub fn verify(
+    fine: &Model,
+    path: &DeformationPath,
+    z: &[f64],
+    k_samples: usize,
+    obstacles: &[Arc<Obstacle>],
+    objective: Objective,
+) -> Verification {
+    let l = fine.rod.length;
+    let r = fine.rod.radius;
+    let unit = fine.rod.energy_unit();
+    let mut a = vec![0.0; path.n()];
+    let mut shape = Shape::default();
+    let mut energies = Vec::with_capacity(k_samples);
+    let ks: Vec<f64> = (0..k_samples)
+        .map(|j| j as f64 / (k_samples - 1) as f64)
+        .collect();
+    let mut worst: Vec<ObstacleClearance> = obstacles
+        .iter()
+        .map(|o| ObstacleClearance {
+            obstacle: o.name.clone(),
+            clearance: f64::INFINITY,
+            k: 0.0,
+            s: 0.0,
+        })
+        .collect();
+    for &k in &ks {
+        path.shape_at(z, k, &mut a);
+        fine.evaluate_into(&a, &mut shape);
+        let t = fine.energy(&a, &shape, objective, None);
+        energies.push(
+            unit * match objective {
+                Objective::Internal => t.internal(),
+                Objective::Potential => t.potential(),
+            },
+        );
+        for (o, w) in obstacles.iter().zip(worst.iter_mut()) {
+            for (b, p) in shape.positions.iter().enumerate() {
+                let (d, _) = o.signed_distance(p.map(|v| v * l));
+                if d - r < w.clearance {
+                    w.clearance = d - r;
+                    w.k = k;
+                    w.s = fine.mesh.boundaries[b] * l;
+                }
+            }
+        }
+    }
+    let (jmax, &u_max) = energies
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .expect("at least one sample");
+    let min_clearance = worst.iter().map(|w| w.clearance).reduce(f64::min);
+    Verification {
+        u_max,
+        k_at_u_max: ks[jmax],
+        energies,
+        ks,
+        obstacles: worst,
+        min_clearance,
+    }
+}
