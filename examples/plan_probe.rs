@@ -4,13 +4,23 @@ fn main() {
     let case = dlo_planner::case::load(std::path::Path::new(&path)).unwrap();
     let t = std::time::Instant::now();
     let pl = Planner::from_case(&case).unwrap();
-    println!("endpoints {:?} U0 {} U1 {}", t.elapsed(), pl.start.energy.potential(), pl.goal.energy.potential());
+    println!(
+        "endpoints {:?} U0 {} U1 {}",
+        t.elapsed(),
+        pl.start.energy.potential(),
+        pl.goal.energy.potential()
+    );
     let _ = time_eval;
     let r = pl.run(&mut Silent);
     let mut v = serde_json::to_value(&r).unwrap();
     v["replay"]["steps"] = serde_json::Value::Null;
     println!("{}", serde_json::to_string_pretty(&v).unwrap());
-    for s in r.replay.steps.iter() { println!("k {:.3} d {:.4} uo {:.3} uf {:.3} st {:?} conv {}", s.k, s.deviation, s.u_optimal, s.u_feasible, s.stable, s.converged); }
+    for s in r.replay.steps.iter() {
+        println!(
+            "k {:.3} d {:.4} uo {:.3} uf {:.3} st {:?} conv {}",
+            s.k, s.deviation, s.u_optimal, s.u_feasible, s.stable, s.converged
+        );
+    }
 }
 #[allow(dead_code)]
 fn dbg_start(pl: &Planner) {
@@ -19,7 +29,12 @@ fn dbg_start(pl: &Planner) {
     let sh = m.evaluate(&pl.start.a);
     let pose = EndPose::of(m, &pl.start.a, &sh.positions);
     println!("pose {:?}", pose);
-    let sol = dlo_planner::planner::endpoints::solve_end(&pl.base, &pose, &pl.start.a, &pl.static_options);
+    let sol = dlo_planner::planner::endpoints::solve_end(
+        &pl.base,
+        &pose,
+        &pl.start.a,
+        &pl.static_options,
+    );
     println!("a0 {:?}\nsol {:?} {:?}", pl.start.a, sol.a, sol.status);
 }
 #[allow(dead_code)]
@@ -33,9 +48,13 @@ pub fn time_eval(pl: &Planner) {
     let y = vec![0.1; p.m()];
     let mut g = vec![0.0; n];
     let t = std::time::Instant::now();
-    for _ in 0..1000 { p.values(&z, &mut c); }
+    for _ in 0..1000 {
+        p.values(&z, &mut c);
+    }
     println!("values {:?}/eval (m = {})", t.elapsed() / 1000, p.m());
     let t = std::time::Instant::now();
-    for _ in 0..1000 { p.gradient(&z, &y, &mut g); }
+    for _ in 0..1000 {
+        p.gradient(&z, &y, &mut g);
+    }
     println!("gradient {:?}/eval", t.elapsed() / 1000);
 }

@@ -777,7 +777,10 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     }
 
     let (initial, explicit_shape) = match &file.shape {
-        Some(sh) => (coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?, true),
+        Some(sh) => (
+            coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?,
+            true,
+        ),
         None => (
             default_start(&layout, file.solver.perturbation, base.map(|c| c / l)),
             false,

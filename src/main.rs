@@ -429,9 +429,24 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
                 "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4})",
                 path.display(),
                 result.min_clearance.unwrap_or(0.0),
-                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or("?", |o| o.obstacle.as_str()),
-                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or(0.0, |o| o.k),
-                result.verification.obstacles.iter().min_by(|a, b| a.clearance.total_cmp(&b.clearance)).map_or(0.0, |o| o.s),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or("?", |o| o.obstacle.as_str()),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or(0.0, |o| o.k),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or(0.0, |o| o.s),
             );
             ExitCode::from(EXIT_COLLISION)
         }
@@ -451,7 +466,11 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
                 result.replay.max_deviation_over_l,
                 result.replay.k_at_max_deviation,
                 result.replay.tolerance,
-                if result.replay.snaps.is_empty() { String::new() } else { format!(", snap-through at k = {:?}", result.replay.snaps) }
+                if result.replay.snaps.is_empty() {
+                    String::new()
+                } else {
+                    format!(", snap-through at k = {:?}", result.replay.snaps)
+                }
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
         }
@@ -463,7 +482,11 @@ fn plan_summary(r: &PlanReport) -> String {
     use std::fmt::Write;
     let p = r.result;
     let mut o = String::new();
-    let _ = writeln!(o, "case {}: {:?} (optimiser {:?})", r.case, p.status, p.optimiser);
+    let _ = writeln!(
+        o,
+        "case {}: {:?} (optimiser {:?})",
+        r.case, p.status, p.optimiser
+    );
     let _ = writeln!(
         o,
         "  U_max {:.6e} at k = {:.3}   straight path U_max {:.6e}   start {:.6e}  goal {:.6e}",
@@ -473,7 +496,8 @@ fn plan_summary(r: &PlanReport) -> String {
         o,
         "  clearance {}   straight path clearance {}   optimiser violation {:.2e}",
         p.min_clearance.map_or("n/a".into(), |c| format!("{c:.4e}")),
-        p.min_clearance_straight.map_or("n/a".into(), |c| format!("{c:.4e}")),
+        p.min_clearance_straight
+            .map_or("n/a".into(), |c| format!("{c:.4e}")),
         p.violation
     );
     let rp = &p.replay;
@@ -483,7 +507,11 @@ fn plan_summary(r: &PlanReport) -> String {
         rp.max_deviation_over_l,
         rp.k_at_max_deviation,
         rp.tolerance,
-        if rp.coincide { "coincide" } else { "DO NOT COINCIDE" },
+        if rp.coincide {
+            "coincide"
+        } else {
+            "DO NOT COINCIDE"
+        },
         rp.u_max,
         rp.all_stable,
         rp.all_converged,
@@ -572,7 +600,11 @@ fn run_inspect(file: &Path, json: bool) -> ExitCode {
         ins.messages,
         ins.start_time.map_or(0.0, |t| t as f64 * 1e-9),
         ins.end_time.map_or(0.0, |t| t as f64 * 1e-9),
-        if ins.indexed { "indexed" } else { "NOT indexed (run `dlo recover`)" }
+        if ins.indexed {
+            "indexed"
+        } else {
+            "NOT indexed (run `dlo recover`)"
+        }
     );
     for (name, t) in &ins.topics {
         let _ = writeln!(

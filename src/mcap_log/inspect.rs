@@ -57,13 +57,19 @@ pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
                 break;
             }
         };
-        let t = topics.entry(m.channel.topic.clone()).or_insert_with(|| TopicSummary {
-            schema: m.channel.schema.as_ref().map_or(String::new(), |s| s.name.clone()),
-            encoding: m.channel.message_encoding.clone(),
-            first_log_time: m.log_time,
-            monotonic: true,
-            ..Default::default()
-        });
+        let t = topics
+            .entry(m.channel.topic.clone())
+            .or_insert_with(|| TopicSummary {
+                schema: m
+                    .channel
+                    .schema
+                    .as_ref()
+                    .map_or(String::new(), |s| s.name.clone()),
+                encoding: m.channel.message_encoding.clone(),
+                first_log_time: m.log_time,
+                monotonic: true,
+                ..Default::default()
+            });
         if t.messages > 0 && m.log_time < t.last_log_time {
             t.monotonic = false;
         }

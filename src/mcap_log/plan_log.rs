@@ -16,9 +16,7 @@
 //! Log time: path parameter `k` ↦ `10 k` seconds, so the timeline scrubs the deformation, and
 //! the optimal and feasible paths sit at the same times. Optimiser iterations are `0.1 s` apart.
 
-use super::scene::{
-    color, end_pose, gravity_transform, obstacles_update, rod_update, time_of_k,
-};
+use super::scene::{color, end_pose, gravity_transform, obstacles_update, rod_update, time_of_k};
 use super::writer::{LogError, McapWriter};
 use crate::model::Model;
 use crate::obstacle::Obstacle;
@@ -156,9 +154,14 @@ impl PlanObserver for PlanLog {
             "deviation": r.deviation,
             "stable": r.stable,
         });
-        let reactions = (!r.reactions.is_empty()).then(|| json!({"k": r.k, "reactions": r.reactions}));
+        let reactions =
+            (!r.reactions.is_empty()).then(|| json!({"k": r.k, "reactions": r.reactions}));
         self.with(|w| {
-            w.proto(&format!("/rod/{name}"), t, &rod_update(t, "rod", &pts, radius, c))?;
+            w.proto(
+                &format!("/rod/{name}"),
+                t,
+                &rod_update(t, "rod", &pts, radius, c),
+            )?;
             if matches!(r.kind, PathKind::Optimal | PathKind::Feasible) {
                 w.proto(&format!("/end_pose/{name}"), t, &end_pose(t, end, angles))?;
             }
@@ -235,7 +238,11 @@ pub fn log_static(
         0,
         &rod_update(0, "rod", &pts, model.rod.radius, color(0.1, 0.4, 0.9, 1.0)),
     )?;
-    w.proto("/end_pose/shape", 0, &end_pose(0, end, model.angles_at(a, 1.0)))?;
+    w.proto(
+        "/end_pose/shape",
+        0,
+        &end_pose(0, end, model.angles_at(a, 1.0)),
+    )?;
     w.json(
         "/metrics/shape",
         "dlo.ShapeReport",

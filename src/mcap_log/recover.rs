@@ -73,8 +73,8 @@ pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogErr
         messages += 1;
     }
     w.finish()?;
-    let complete = mcap::read::footer(input).is_ok()
-        && matches!(mcap::Summary::read(input), Ok(Some(_)));
+    let complete =
+        mcap::read::footer(input).is_ok() && matches!(mcap::Summary::read(input), Ok(Some(_)));
     Ok(Recovery {
         messages,
         truncated: stopped_at.is_some() || !complete,

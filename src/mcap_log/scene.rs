@@ -197,7 +197,11 @@ fn pose_of(position: [f64; 3], m: [[f64; 3]; 3]) -> Pose {
 }
 
 /// Obstacles as one entity each; `length` scales the half-space slab.
-pub fn obstacles_update(t: u64, obstacles: &[std::sync::Arc<Obstacle>], length: f64) -> SceneUpdate {
+pub fn obstacles_update(
+    t: u64,
+    obstacles: &[std::sync::Arc<Obstacle>],
+    length: f64,
+) -> SceneUpdate {
     let grey = color(0.55, 0.6, 0.7, 0.6);
     let entities = obstacles
         .iter()

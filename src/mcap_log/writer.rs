@@ -107,7 +107,12 @@ impl<W: Write + Seek> McapWriter<W> {
     }
 
     /// Writes a Foxglove protobuf message on `topic` at `log_time` (ns).
-    pub fn proto<T: Encode>(&mut self, topic: &str, log_time: u64, msg: &T) -> Result<(), LogError> {
+    pub fn proto<T: Encode>(
+        &mut self,
+        topic: &str,
+        log_time: u64,
+        msg: &T,
+    ) -> Result<(), LogError> {
         let schema = T::get_schema().expect("Foxglove schemas carry a descriptor");
         let id = self.channel(
             topic,

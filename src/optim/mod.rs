@@ -8,7 +8,8 @@ pub mod nlp;
 pub mod second_order;
 
 pub use augmented_lagrangian::{
-    AlOptions, AlOutcome, AlStatus, OuterIterate, augmented_lagrangian, augmented_lagrangian_observed,
+    AlOptions, AlOutcome, AlStatus, OuterIterate, augmented_lagrangian,
+    augmented_lagrangian_observed,
 };
 pub use bfgs::{BfgsOptions, BfgsOutcome, BfgsStatus, bfgs};
 pub use nlp::{Nlp, Sense};

@@ -135,8 +135,8 @@ impl MinimaxProblem {
         for (sh, tj) in self.shapes.iter().zip(t) {
             let nb = tj.len() as f64;
             for (x, xb) in sh.positions.iter().zip(tj) {
-                sum += ((x[0] - xb[0]).powi(2) + (x[1] - xb[1]).powi(2) + (x[2] - xb[2]).powi(2))
-                    / nb;
+                sum +=
+                    ((x[0] - xb[0]).powi(2) + (x[1] - xb[1]).powi(2) + (x[2] - xb[2]).powi(2)) / nb;
             }
         }
         0.5 * self.track_weight * sum
@@ -174,9 +174,12 @@ impl Nlp for MinimaxProblem {
             self.path.shape_at(z, k, &mut self.a[j]);
             self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
             self.gu[j].iter_mut().for_each(|g| *g = 0.0);
-            let t = self
-                .model
-                .energy(&self.a[j], &self.shapes[j], self.objective, Some(&mut self.gu[j]));
+            let t = self.model.energy(
+                &self.a[j],
+                &self.shapes[j],
+                self.objective,
+                Some(&mut self.gu[j]),
+            );
             self.u[j] = match self.objective {
                 Objective::Internal => t.internal(),
                 Objective::Potential => t.potential(),

@@ -109,6 +109,8 @@ pub struct PlanResult {
     pub z: Vec<f64>,
     /// Feasibility replay.
     pub replay: Replay,
+    /// `k` samples added where the verification grid found tunnelling.
+    pub added_samples: Vec<f64>,
     /// Seconds spent planning (optimise + verify) and replaying.
     pub timing_s: Timing,
 }
@@ -261,6 +263,7 @@ fn noise(seed: u64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+#[derive(Clone)]
 struct StartRun {
     z: Vec<f64>,
     status: AlStatus,
@@ -274,7 +277,10 @@ impl Planner {
     /// Validates the case's `plan` section and solves the start and goal shapes.
     pub fn from_case(case: &Case) -> Result<Planner, Error> {
         let options = spec::plan_options(case)?;
-        let static_options = case.options;
+        // Replay and endpoint solves: the case's settings, with the optimality tolerance no
+        // tighter than 1e-5 (replayed shapes are compared at the 1e-3 L level).
+        let mut static_options = case.options;
+        static_options.al.optimality_tol = static_options.al.optimality_tol.max(1e-5);
         let start = end_shape(case, "start", &options.start, &static_options)?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
@@ -301,9 +307,13 @@ impl Planner {
 
     /// The optimiser's problem with `blocks` from the case and the safety margin.
     pub fn minimax_problem(&self) -> MinimaxProblem {
-        let (_, blocks) = classify(&self.base, self.options.safety);
         let nk = self.options.k_samples;
-        let ks = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
+        self.minimax_problem_at((0..nk).map(|j| j as f64 / (nk - 1) as f64).collect())
+    }
+
+    /// The optimiser's problem on the samples `ks` (increasing, from 0 to 1).
+    pub fn minimax_problem_at(&self, ks: Vec<f64>) -> MinimaxProblem {
+        let (_, blocks) = classify(&self.base, self.options.safety);
         let mut p = MinimaxProblem::new(
             self.base.model.clone(),
             self.path(),
@@ -315,8 +325,8 @@ impl Planner {
         p
     }
 
-    fn optimise_from(&self, start: usize, z0: Vec<f64>) -> StartRun {
-        let mut p = self.minimax_problem();
+    fn optimise_from(&self, start: usize, z0: Vec<f64>, ks: &[f64]) -> StartRun {
+        let mut p = self.minimax_problem_at(ks.to_vec());
         let unit = self.base.model.rod.energy_unit();
         let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
         // Energy scale of the sharpness: the straight path's largest sampled energy.
@@ -354,38 +364,32 @@ impl Planner {
                 let mw = pp.mean_weight;
                 // The observer needs the sampled energies at the iterate: re-evaluate a cheap
                 // copy of the problem.
-                let mut probe = self.minimax_problem();
+                let mut probe = self.minimax_problem_at(ks.clone());
                 probe.beta = beta;
                 probe.mean_weight = mw;
-                augmented_lagrangian_observed(
-                    pp,
-                    &mut z,
-                    lambda.as_deref(),
-                    al,
-                    &mut |it| {
-                        let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
-                        let u = probe.energies();
-                        let (j, &umax) = u
-                            .iter()
-                            .enumerate()
-                            .max_by(|a, b| a.1.total_cmp(b.1))
-                            .expect("samples");
-                        let mean = u.iter().sum::<f64>() / u.len() as f64;
-                        progress.push((
-                            Progress {
-                                start,
-                                stage,
-                                outer: it.outer,
-                                smoothed_max: (f - mw * mean) * unit,
-                                sampled_max: umax * unit,
-                                k_worst: ks[j],
-                                violation: it.violation,
-                                rho: it.rho,
-                            },
-                            probe.sampled()[j].clone(),
-                        ));
-                    },
-                )
+                augmented_lagrangian_observed(pp, &mut z, lambda.as_deref(), al, &mut |it| {
+                    let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
+                    let u = probe.energies();
+                    let (j, &umax) = u
+                        .iter()
+                        .enumerate()
+                        .max_by(|a, b| a.1.total_cmp(b.1))
+                        .expect("samples");
+                    let mean = u.iter().sum::<f64>() / u.len() as f64;
+                    progress.push((
+                        Progress {
+                            start,
+                            stage,
+                            outer: it.outer,
+                            smoothed_max: (f - mw * mean) * unit,
+                            sampled_max: umax * unit,
+                            k_worst: ks[j],
+                            violation: it.violation,
+                            rho: it.rho,
+                        },
+                        probe.sampled()[j].clone(),
+                    ));
+                })
             };
             evaluations += out.evaluations;
             status = out.status;
@@ -418,7 +422,13 @@ impl Planner {
                     &self.static_options,
                 );
                 p.targets = Some(targets);
-                let out = augmented_lagrangian_observed(&mut p, &mut z, lambda.as_deref(), al, &mut |_| {});
+                let out = augmented_lagrangian_observed(
+                    &mut p,
+                    &mut z,
+                    lambda.as_deref(),
+                    al,
+                    &mut |_| {},
+                );
                 evaluations += out.evaluations;
                 status = out.status;
                 violation = out.max_violation;
@@ -429,7 +439,12 @@ impl Planner {
             }
         }
         crate::optim::Nlp::values(&mut p, &z, &mut c);
-        let sampled_max = p.energies().iter().copied().fold(f64::NEG_INFINITY, f64::max) * unit;
+        let sampled_max = p
+            .energies()
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+            * unit;
         StartRun {
             z,
             status,
@@ -482,7 +497,9 @@ impl Planner {
                 let k = i as f64 / steps as f64;
                 path.shape_at(&vec![0.0; nv], k, &mut a);
                 model.evaluate_into(&a, &mut sh);
-                let e = model.energy(&a, &sh, self.base.objective, None).scaled(unit);
+                let e = model
+                    .energy(&a, &sh, self.base.objective, None)
+                    .scaled(unit);
                 observer.shape(
                     model,
                     &ShapeRecord {
@@ -509,8 +526,10 @@ impl Planner {
                     .collect()
             })
             .collect();
+        let nk = self.options.k_samples;
+        let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let runs: Vec<StartRun> = if starts.len() == 1 {
-            vec![self.optimise_from(0, starts[0].clone())]
+            vec![self.optimise_from(0, starts[0].clone(), &uniform)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
@@ -524,9 +543,10 @@ impl Planner {
                     .into_iter()
                     .map(|idx| {
                         let starts = &starts;
+                        let uniform = &uniform;
                         sc.spawn(move || {
                             idx.into_iter()
-                                .map(|i| (i, self.optimise_from(i, starts[i].clone())))
+                                .map(|i| (i, self.optimise_from(i, starts[i].clone(), uniform)))
                                 .collect::<Vec<_>>()
                         })
                     })
@@ -537,7 +557,10 @@ impl Planner {
                     }
                 }
             });
-            results.into_iter().map(|r| r.expect("every start ran")).collect()
+            results
+                .into_iter()
+                .map(|r| r.expect("every start ran"))
+                .collect()
         };
         for r in &runs {
             for (pr, worst) in &r.progress {
@@ -555,9 +578,9 @@ impl Planner {
             })
             .map(|(i, _)| i)
             .expect("at least one start");
-        let chosen = &runs[best];
+        let mut chosen = runs[best].clone();
         observer.phase("verify");
-        let ver = verify(
+        let mut ver = verify(
             &fine,
             &path,
             &chosen.z,
@@ -565,6 +588,45 @@ impl Planner {
             &self.obstacles,
             self.base.objective,
         );
+        // Tunnelling between samples: add the verification grid's worst k (and its neighbours
+        // on that grid) to the optimiser's samples and optimise again from the current path.
+        let tol = 1e-6 * model.rod.length;
+        let mut ks = uniform.clone();
+        let mut added = Vec::new();
+        let h = 1.0 / (self.options.verify_k - 1) as f64;
+        for _ in 0..self.options.sample_refinements {
+            if ver.collision_free(tol) {
+                break;
+            }
+            for o in ver.obstacles.iter().filter(|o| o.clearance < -tol) {
+                for k in [o.k - h, o.k, o.k + h] {
+                    if k > 0.0 && k < 1.0 && !ks.iter().any(|&q| (q - k).abs() < 0.25 * h) {
+                        ks.push(k);
+                        added.push(k);
+                    }
+                }
+            }
+            ks.sort_by(f64::total_cmp);
+            observer.phase("optimise");
+            let r = self.optimise_from(best, chosen.z.clone(), &ks);
+            for (pr, worst) in &r.progress {
+                observer.progress(model, pr, worst);
+            }
+            chosen = StartRun {
+                evaluations: chosen.evaluations + r.evaluations,
+                ..r
+            };
+            observer.phase("verify");
+            ver = verify(
+                &fine,
+                &path,
+                &chosen.z,
+                self.options.verify_k,
+                &self.obstacles,
+                self.base.objective,
+            );
+        }
+        let chosen = &chosen;
         let t_plan = t0.elapsed().as_secs_f64();
 
         observer.phase("replay");
@@ -583,7 +645,6 @@ impl Planner {
             observer,
         );
         let t_replay = t1.elapsed().as_secs_f64();
-        let tol = 1e-6 * model.rod.length;
         let status = if !ver.collision_free(tol) {
             PlanStatus::Collision
         } else if chosen.status != AlStatus::Converged {
@@ -612,6 +673,7 @@ impl Planner {
                 })
                 .collect(),
             path: path.c_vectors(&chosen.z),
+            added_samples: added,
             z: chosen.z.clone(),
             verification: ver,
             replay: rep,

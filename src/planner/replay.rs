@@ -27,6 +27,10 @@ pub struct ReplayStep {
     pub u_feasible: f64,
     /// The static solve converged.
     pub converged: bool,
+    /// Solver status of the static solve.
+    pub status: SolveStatus,
+    /// Its KKT residual (dimensionless).
+    pub kkt_residual: f64,
     /// Stability of the replayed shape.
     pub stable: Option<bool>,
     /// Constraint violation of the solve (dimensionless).
@@ -106,9 +110,7 @@ pub fn replay(
     let mut optimal_at = |k: f64| -> (Vec<f64>, Vec<[f64; 3]>, f64) {
         path.shape_at(z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
-        let u = model
-            .energy(&a, &shape, base.objective, None)
-            .scaled(unit);
+        let u = model.energy(&a, &shape, base.objective, None).scaled(unit);
         let u = match base.objective {
             crate::energy::Objective::Internal => u.internal(),
             crate::energy::Objective::Potential => u.potential(),
@@ -136,9 +138,9 @@ pub fn replay(
     let mut steps: Vec<ReplayStep> = Vec::new();
     let mut snaps = Vec::new();
     let record = |st: &State,
-                      target: &(Vec<f64>, Vec<[f64; 3]>, f64),
-                      steps: &mut Vec<ReplayStep>,
-                      observer: &mut dyn PlanObserver| {
+                  target: &(Vec<f64>, Vec<[f64; 3]>, f64),
+                  steps: &mut Vec<ReplayStep>,
+                  observer: &mut dyn PlanObserver| {
         let d = max_distance(&st.positions, &target.1) * l;
         steps.push(ReplayStep {
             k: st.k,
@@ -149,6 +151,8 @@ pub fn replay(
                 crate::energy::Objective::Potential => st.sol.energy.potential(),
             },
             converged: st.sol.status == SolveStatus::Converged,
+            status: st.sol.status,
+            kkt_residual: st.sol.kkt_residual,
             stable: st.sol.stable,
             violation: st.sol.max_violation,
         });
@@ -156,7 +160,9 @@ pub fn replay(
         let opt_terms = {
             let mut sh = Shape::default();
             model.evaluate_into(&target.0, &mut sh);
-            model.energy(&target.0, &sh, base.objective, None).scaled(unit)
+            model
+                .energy(&target.0, &sh, base.objective, None)
+                .scaled(unit)
         };
         observer.shape(
             model,

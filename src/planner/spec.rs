@@ -50,6 +50,9 @@ pub struct PlanSpec {
     /// Size (radians) of the extra starts' perturbations.
     #[serde(default = "d_spread")]
     pub start_spread: f64,
+    /// Rounds of adding samples where the verification grid finds tunnelling.
+    #[serde(default = "d_sample_ref")]
+    pub sample_refinements: usize,
     /// Replay steps in `k` (refined where the replayed shape jumps).
     #[serde(default = "d_steps")]
     pub replay_steps: usize,
@@ -93,6 +96,9 @@ fn d_seed() -> u64 {
 }
 fn d_spread() -> f64 {
     0.5
+}
+fn d_sample_ref() -> usize {
+    4
 }
 fn d_steps() -> usize {
     40
@@ -175,6 +181,8 @@ pub struct PlanOptions {
     pub seed: u64,
     /// Perturbation of extra starts (radians).
     pub spread: f64,
+    /// Rounds of sample refinement against tunnelling.
+    pub sample_refinements: usize,
     /// Replay steps.
     pub replay_steps: usize,
     /// Bisections per replay step.
@@ -278,6 +286,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         ("plan.starts", spec.starts, 1, 64),
         ("plan.replay_steps", spec.replay_steps, 1, 100_000),
         ("plan.replay_refinements", spec.replay_refinements, 0, 20),
+        ("plan.sample_refinements", spec.sample_refinements, 0, 20),
     ] {
         if !(lo..=hi).contains(&val) {
             return Err(v.err(field, format!("must be in {lo}..={hi}, got {val}")));
@@ -333,6 +342,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         starts: spec.starts,
         seed: spec.seed,
         spread: spec.start_spread,
+        sample_refinements: spec.sample_refinements,
         replay_steps: spec.replay_steps,
         refinements: spec.replay_refinements,
         tolerance: spec.coincide_tolerance,
