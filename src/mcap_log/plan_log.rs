@@ -5,7 +5,7 @@
 //! | topic | schema | content |
 //! |---|---|---|
 //! | `/tf` | `foxglove.FrameTransform` | `world → rod`, gravity down |
-//! | `/scene/obstacles` | `foxglove.SceneUpdate` | obstacles as primitives |
+//! | `/scene/obstacles` | `foxglove.SceneUpdate` | obstacles as primitives (when there are any) |
 //! | `/rod/endpoints`, `/rod/straight`, `/rod/optimal`, `/rod/feasible` | `foxglove.SceneUpdate` | the rod |
 //! | `/end_pose/optimal`, `/end_pose/feasible` | `foxglove.PoseInFrame` | controlled end `s = L` |
 //! | `/metrics/…` (same four) | JSON | `k`, energy terms, clearance, deviation, stability |
@@ -120,7 +120,9 @@ impl PlanObserver for PlanLog {
         let l = model.rod.length;
         self.with(|w| {
             w.proto("/tf", 0, &gravity_transform(0))?;
-            w.proto("/scene/obstacles", 0, &obstacles_update(0, &obstacles, l))?;
+            if !obstacles.is_empty() {
+                w.proto("/scene/obstacles", 0, &obstacles_update(0, &obstacles, l))?;
+            }
             w.flush()
         });
     }
@@ -228,11 +230,13 @@ pub fn log_static(
     let pts = rod_points(model, a);
     let end = *pts.last().expect("at least two boundaries");
     w.proto("/tf", 0, &gravity_transform(0))?;
-    w.proto(
-        "/scene/obstacles",
-        0,
-        &obstacles_update(0, obstacles, model.rod.length),
-    )?;
+    if !obstacles.is_empty() {
+        w.proto(
+            "/scene/obstacles",
+            0,
+            &obstacles_update(0, obstacles, model.rod.length),
+        )?;
+    }
     w.proto(
         "/rod/shape",
         0,

@@ -1,0 +1,223 @@
+//! The MCAP logs read back with the `mcap` crate: every message decodes as its schema, the rod
+//! shapes logged equal the shapes computed, log times never go backwards on a topic; a killed
+//! writer's finished chunks are recovered. Logs are left in `target/test-logs/` for the
+//! reference Python reader (`.ci/run`).
+
+use dlo_planner::case;
+use dlo_planner::mcap_log::recover::recover;
+use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter};
+use dlo_planner::planner::Planner;
+use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
+use foxglove::Decode;
+use foxglove::schemas::{FrameTransform, PoseInFrame, SceneUpdate};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::{Arc, Mutex};
+
+fn log_dir() -> PathBuf {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-logs");
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Counts shapes and forwards to the log.
+struct Counting {
+    log: PlanLog,
+    shapes: u64,
+}
+
+impl PlanObserver for Counting {
+    fn begin(&mut self, m: &dlo_planner::model::Model) {
+        self.log.begin(m);
+    }
+    fn phase(&mut self, n: &str) {
+        self.log.phase(n);
+    }
+    fn shape(&mut self, m: &dlo_planner::model::Model, r: &ShapeRecord) {
+        self.shapes += 1;
+        self.log.shape(m, r);
+    }
+    fn progress(&mut self, m: &dlo_planner::model::Model, p: &Progress, w: &[f64]) {
+        self.log.progress(m, p, w);
+    }
+}
+
+/// Decodes every message; returns messages per topic. Panics on a bad message or time order.
+fn check_log(bytes: &[u8]) -> HashMap<String, usize> {
+    let summary = mcap::Summary::read(bytes).unwrap();
+    assert!(summary.is_some(), "the log has a summary (it was finished)");
+    let mut last: HashMap<String, u64> = HashMap::new();
+    let mut counts: HashMap<String, usize> = HashMap::new();
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        let topic = m.channel.topic.clone();
+        let schema = m.channel.schema.as_ref().unwrap().name.clone();
+        match schema.as_str() {
+            "foxglove.SceneUpdate" => {
+                let u = SceneUpdate::decode(&m.data[..]).unwrap();
+                assert!(!u.entities.is_empty(), "{topic}");
+                if topic.starts_with("/rod/") {
+                    let line = &u.entities[0].lines[0];
+                    assert!(line.points.len() >= 2);
+                    assert!(line.thickness > 0.0);
+                }
+            }
+            "foxglove.FrameTransform" => {
+                let t = FrameTransform::decode(&m.data[..]).unwrap();
+                assert_eq!(t.child_frame_id, "rod");
+            }
+            "foxglove.PoseInFrame" => {
+                PoseInFrame::decode(&m.data[..]).unwrap();
+            }
+            _ => {
+                assert_eq!(m.channel.message_encoding, "json", "{topic} {schema}");
+                let _: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            }
+        }
+        if let Some(&t) = last.get(&topic) {
+            assert!(m.log_time >= t, "{topic}: time goes backwards");
+        }
+        last.insert(topic.clone(), m.log_time);
+        *counts.entry(topic).or_default() += 1;
+    }
+    counts
+}
+
+#[test]
+fn plan_log_decodes_and_counts_every_shape() {
+    let c = case::load(Path::new("planning_cases/plan_paper_planar.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let path = log_dir().join("plan_paper_planar.mcap");
+    let w: SharedWriter = Arc::new(Mutex::new(McapWriter::create(&path).unwrap()));
+    let mut obs = Counting {
+        log: PlanLog::new(w.clone(), c.obstacles.clone()),
+        shapes: 0,
+    };
+    let r = p.run(&mut obs);
+    assert!(obs.log.error().is_none());
+    w.lock().unwrap().finish().unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let counts = check_log(&bytes);
+    let rods: usize = counts
+        .iter()
+        .filter(|(t, _)| t.starts_with("/rod/"))
+        .map(|(_, n)| n)
+        .sum();
+    assert_eq!(rods as u64, obs.shapes);
+    assert_eq!(counts["/rod/feasible"], r.replay.steps.len());
+    assert_eq!(counts["/rod/optimal"], r.replay.steps.len());
+    assert_eq!(counts["/metrics/feasible"], r.replay.steps.len());
+    assert_eq!(counts["/scene/obstacles"], 1);
+    assert!(counts["/optimiser/progress"] > 0);
+}
+
+#[test]
+fn shape_command_logs_its_solve() {
+    let dir = log_dir();
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["shape", "planning_cases/grasp_a_080.json", "--log-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(dir.join("grasp_a_080.mcap")).unwrap();
+    let counts = check_log(&bytes);
+    assert_eq!(counts["/rod/shape"], 1);
+}
+
+/// A writer stopped without finishing (as if killed): the chunks it closed are recovered.
+#[test]
+fn unfinished_log_is_recovered() {
+    let path = log_dir().join("unfinished_unit.mcap");
+    let mut w = McapWriter::create(&path).unwrap();
+    let up = dlo_planner::mcap_log::scene::rod_update(
+        0,
+        "rod",
+        &[[0.0; 3], [0.0, 0.0, 1.0]],
+        0.01,
+        dlo_planner::mcap_log::scene::color(1.0, 0.0, 0.0, 1.0),
+    );
+    for i in 0..500u64 {
+        w.proto("/rod/optimal", i * 1000, &up).unwrap();
+    }
+    w.flush().unwrap();
+    for i in 500..510u64 {
+        w.proto("/rod/optimal", i * 1000, &up).unwrap();
+    }
+    // The bytes on disk now are what a killed process leaves; the writer never finishes.
+    let bytes = std::fs::read(&path).unwrap();
+    std::mem::forget(w);
+    std::fs::remove_file(&path).unwrap();
+    assert!(mcap::Summary::read(&bytes).map(|s| s.is_none()).unwrap_or(true));
+    let mut fixed = std::io::Cursor::new(Vec::new());
+    let r = recover(&bytes, &mut fixed).unwrap();
+    assert!(r.truncated);
+    assert!(r.messages >= 500, "{}", r.messages);
+    let fixed = fixed.into_inner();
+    let counts = check_log(&fixed);
+    assert_eq!(counts["/rod/optimal"] as u64, r.messages);
+    std::fs::write(log_dir().join("recovered_unit.mcap"), &fixed).unwrap();
+}
+
+/// A real run killed with SIGKILL mid-way leaves a file whose finished chunks `dlo recover`
+/// turns into an indexed log.
+#[test]
+#[cfg(unix)]
+fn killed_plan_is_recovered_by_the_cli() {
+    let dir = log_dir().join("killed");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let broken = dir.join("plan_paper_planar.mcap");
+    // Wait until the first chunk is on disk, then kill.
+    let t0 = std::time::Instant::now();
+    while std::fs::metadata(&broken).map_or(0, |m| m.len()) < 1000
+        && t0.elapsed().as_secs() < 30
+    {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the run was killed before it finished");
+    let fixed = log_dir().join("killed_recovered.mcap");
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .arg("recover")
+        .arg(&broken)
+        .arg(&fixed)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&fixed).unwrap();
+    let counts = check_log(&bytes);
+    assert!(counts.get("/scene/obstacles").copied().unwrap_or(0) == 1, "{counts:?}");
+    let inspect = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .arg("inspect")
+        .arg(&fixed)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(inspect.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&inspect.stdout).unwrap();
+    assert_eq!(v["indexed"], true);
+    assert_eq!(v["messages"].as_u64().unwrap() as usize, counts.values().sum::<usize>());
+}
+
+#[test]
+fn plot_writes_an_svg_from_a_log() {
+    let dir = log_dir().join("plot");
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "planning_cases/plan_paper_planar.json", "--plot", "--log-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    // Exit 0 or 5 (replay verdict); the picture is written either way.
+    assert!(matches!(out.status.code(), Some(0) | Some(5)), "{:?}", out.status);
+    let svg = std::fs::read_to_string(dir.join("plan_paper_planar.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("polyline"), "{}", &svg[..200.min(svg.len())]);
+}
