@@ -120,11 +120,15 @@ pub fn replay(
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
         let pose = EndPose::of(model, &target.0, &target.1);
         let mut p = pose.problem(base);
-        let sol = if from.sol.lambda.len() == crate::optim::Nlp::m(&p) {
+        let mut sol = if from.sol.lambda.len() == crate::optim::Nlp::m(&p) {
             solve_static_warm(&mut p, &from.sol.a, &from.sol.lambda, static_opts)
         } else {
             crate::statics::solve_static(&mut p, &from.sol.a, static_opts)
         };
+        // A solve that ran out of iterations gets one more budget from where it stopped.
+        if sol.status == SolveStatus::IterationLimit {
+            sol = solve_static_warm(&mut p, &sol.a, &sol.lambda, static_opts);
+        }
         let positions = model.evaluate(&sol.a).positions;
         State { k, sol, positions }
     };
