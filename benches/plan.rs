@@ -25,7 +25,9 @@ fn benches(c: &mut Criterion) {
     let (case, pl) = planner("plan_paper_planar.json");
     let mut g = c.benchmark_group("paper planar");
     g.sample_size(10);
-    g.bench_function("plan + verify + replay, no log", |b| b.iter(|| pl.run(&mut Silent)));
+    g.bench_function("plan + verify + replay, no log", |b| {
+        b.iter(|| pl.run(&mut Silent))
+    });
     let dir = std::env::temp_dir().join("dlo-bench");
     std::fs::create_dir_all(&dir).unwrap();
     g.bench_function("plan + verify + replay, MCAP log", |b| {
@@ -47,7 +49,17 @@ fn benches(c: &mut Criterion) {
         tolerance: pl.options.tolerance,
     };
     g.bench_function("replay (41 steps)", |b| {
-        b.iter(|| replay(&pl.base, &pl.start, &path, &r.z, opts, &pl.static_options, &mut Silent))
+        b.iter(|| {
+            replay(
+                &pl.base,
+                &pl.start,
+                &path,
+                &r.z,
+                opts,
+                &pl.static_options,
+                &mut Silent,
+            )
+        })
     });
     g.finish();
 }

@@ -120,7 +120,11 @@ fn shape_command_logs_its_solve() {
         .arg(&dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bytes = std::fs::read(dir.join("grasp_a_080.mcap")).unwrap();
     let counts = check_log(&bytes);
     assert_eq!(counts["/rod/shape"], 1);
@@ -149,7 +153,11 @@ fn unfinished_log_is_recovered() {
     let bytes = std::fs::read(&path).unwrap();
     std::mem::forget(w);
     std::fs::remove_file(&path).unwrap();
-    assert!(mcap::Summary::read(&bytes).map(|s| s.is_none()).unwrap_or(true));
+    assert!(
+        mcap::Summary::read(&bytes)
+            .map(|s| s.is_none())
+            .unwrap_or(true)
+    );
     let mut fixed = std::io::Cursor::new(Vec::new());
     let r = recover(&bytes, &mut fixed).unwrap();
     assert!(r.truncated);
@@ -175,11 +183,10 @@ fn killed_plan_is_recovered_by_the_cli() {
         .spawn()
         .unwrap();
     let broken = dir.join("plan_paper_planar.mcap");
-    // Wait until the first chunk is on disk, then kill.
+    // Wait until the chunk with the straight-line path is on disk (closed when optimisation
+    // starts, about 4 KiB in), then kill.
     let t0 = std::time::Instant::now();
-    while std::fs::metadata(&broken).map_or(0, |m| m.len()) < 1000
-        && t0.elapsed().as_secs() < 30
-    {
+    while std::fs::metadata(&broken).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     child.kill().unwrap();
@@ -192,10 +199,17 @@ fn killed_plan_is_recovered_by_the_cli() {
         .arg(&fixed)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bytes = std::fs::read(&fixed).unwrap();
     let counts = check_log(&bytes);
-    assert!(counts.get("/scene/obstacles").copied().unwrap_or(0) == 1, "{counts:?}");
+    assert!(
+        counts.get("/scene/obstacles").copied().unwrap_or(0) == 1,
+        "{counts:?}"
+    );
     let inspect = Command::new(env!("CARGO_BIN_EXE_dlo"))
         .arg("inspect")
         .arg(&fixed)
@@ -205,19 +219,35 @@ fn killed_plan_is_recovered_by_the_cli() {
     assert!(inspect.status.success());
     let v: serde_json::Value = serde_json::from_slice(&inspect.stdout).unwrap();
     assert_eq!(v["indexed"], true);
-    assert_eq!(v["messages"].as_u64().unwrap() as usize, counts.values().sum::<usize>());
+    assert_eq!(
+        v["messages"].as_u64().unwrap() as usize,
+        counts.values().sum::<usize>()
+    );
 }
 
 #[test]
 fn plot_writes_an_svg_from_a_log() {
     let dir = log_dir().join("plot");
     let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "planning_cases/plan_paper_planar.json", "--plot", "--log-dir"])
+        .args([
+            "plan",
+            "planning_cases/plan_paper_planar.json",
+            "--plot",
+            "--log-dir",
+        ])
         .arg(&dir)
         .output()
         .unwrap();
     // Exit 0 or 5 (replay verdict); the picture is written either way.
-    assert!(matches!(out.status.code(), Some(0) | Some(5)), "{:?}", out.status);
+    assert!(
+        matches!(out.status.code(), Some(0) | Some(5)),
+        "{:?}",
+        out.status
+    );
     let svg = std::fs::read_to_string(dir.join("plan_paper_planar.svg")).unwrap();
-    assert!(svg.starts_with("<svg") && svg.contains("polyline"), "{}", &svg[..200.min(svg.len())]);
+    assert!(
+        svg.starts_with("<svg") && svg.contains("polyline"),
+        "{}",
+        &svg[..200.min(svg.len())]
+    );
 }

@@ -325,7 +325,13 @@ impl Planner {
         p
     }
 
-    fn optimise_from(&self, start: usize, z0: Vec<f64>, ks: &[f64]) -> StartRun {
+    fn optimise_from(
+        &self,
+        start: usize,
+        z0: Vec<f64>,
+        ks: &[f64],
+        first_stage: usize,
+    ) -> StartRun {
         let mut p = self.minimax_problem_at(ks.to_vec());
         let unit = self.base.model.rod.energy_unit();
         let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
@@ -353,7 +359,7 @@ impl Planner {
             max_inner: 300,
             active_tol: 1e-7,
         };
-        for (stage, &b) in self.options.sharpness.iter().enumerate() {
+        for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
             let out = {
                 let pp = &mut p;
@@ -421,7 +427,18 @@ impl Planner {
                     &p.ks,
                     &self.static_options,
                 );
+                let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
+                    old.iter()
+                        .zip(&targets)
+                        .flat_map(|(a, b)| a.iter().zip(b))
+                        .map(|(u, v)| (0..3).map(|i| (u[i] - v[i]).abs()).fold(0.0, f64::max))
+                        .fold(0.0, f64::max)
+                });
                 p.targets = Some(targets);
+                // Targets that no longer move: the path already sits on its equilibria.
+                if moved < 1e-4 {
+                    break;
+                }
                 let out = augmented_lagrangian_observed(
                     &mut p,
                     &mut z,
@@ -529,7 +546,7 @@ impl Planner {
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let runs: Vec<StartRun> = if starts.len() == 1 {
-            vec![self.optimise_from(0, starts[0].clone(), &uniform)]
+            vec![self.optimise_from(0, starts[0].clone(), &uniform, 0)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
@@ -546,7 +563,7 @@ impl Planner {
                         let uniform = &uniform;
                         sc.spawn(move || {
                             idx.into_iter()
-                                .map(|i| (i, self.optimise_from(i, starts[i].clone(), uniform)))
+                                .map(|i| (i, self.optimise_from(i, starts[i].clone(), uniform, 0)))
                                 .collect::<Vec<_>>()
                         })
                     })
@@ -608,7 +625,9 @@ impl Planner {
             }
             ks.sort_by(f64::total_cmp);
             observer.phase("optimise");
-            let r = self.optimise_from(best, chosen.z.clone(), &ks);
+            // Warm: only the sharpest stage again.
+            let last = self.options.sharpness.len() - 1;
+            let r = self.optimise_from(best, chosen.z.clone(), &ks, last);
             for (pr, worst) in &r.progress {
                 observer.progress(model, pr, worst);
             }

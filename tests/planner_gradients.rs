@@ -1,0 +1,111 @@
+//! Finite-difference checks of the planner's analytic gradients: the smoothed maximum, the mean
+//! energy, the equilibrium-tracking term and the sampled path constraints, all chained through
+//! the path parameterisation and the null space of the fixed conditions.
+
+use dlo_planner::case;
+use dlo_planner::optim::Nlp;
+use dlo_planner::planner::Planner;
+use std::path::Path;
+
+fn check(name: &str, tracking: bool) {
+    let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
+    let pl = Planner::from_case(&c).unwrap();
+    let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
+    let mut p = pl.minimax_problem_at(ks.clone());
+    p.beta = 3.0;
+    p.mean_weight = 0.7;
+    let n = p.n();
+    let m = p.m();
+    let z: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 1.7).sin()).collect();
+    if tracking {
+        // Targets: the sampled shapes of another path.
+        let z2: Vec<f64> = (0..n).map(|i| 0.04 * ((i as f64) * 0.9).cos()).collect();
+        let mut c = vec![0.0; m];
+        p.values(&z2, &mut c);
+        let targets: Vec<Vec<[f64; 3]>> = p
+            .sampled()
+            .iter()
+            .map(|a| p.model.evaluate(a).positions)
+            .collect();
+        p.targets = Some(targets);
+        p.track_weight = 50.0;
+    }
+    let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
+    let mut c = vec![0.0; m];
+    let phi = |p: &mut dlo_planner::planner::minimax::MinimaxProblem, x: &[f64]| {
+        let mut c = vec![0.0; m];
+        let f = p.values(x, &mut c);
+        f + y.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>()
+    };
+    p.values(&z, &mut c);
+    let mut g = vec![0.0; n];
+    p.gradient(&z, &y, &mut g);
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        let mut zp = z.clone();
+        zp[i] += h;
+        let mut zm = z.clone();
+        zm[i] -= h;
+        let fd = (phi(&mut p, &zp) - phi(&mut p, &zm)) / (2.0 * h);
+        let scale = g.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
+        worst = worst.max((fd - g[i]).abs() / scale);
+    }
+    assert!(
+        worst < 1e-6,
+        "{name} (tracking {tracking}): relative error {worst:e}"
+    );
+}
+
+#[test]
+fn planar_minimax_gradient_matches_finite_differences() {
+    check("plan_paper_planar.json", false);
+}
+
+#[test]
+fn planar_minimax_gradient_with_tracking_matches_finite_differences() {
+    check("plan_paper_planar.json", true);
+}
+
+#[test]
+fn spatial_minimax_gradient_matches_finite_differences() {
+    check("plan_cable_around_pillar.json", true);
+}
+
+#[test]
+fn path_ends_on_its_shapes_and_keeps_linear_conditions() {
+    use dlo_planner::path::DeformationPath;
+    let a0 = vec![0.0, 1.0, 0.5, -0.2];
+    let a1 = vec![0.3, -1.0, 0.1, 0.4];
+    // A linear condition on a[1] + a[2]: every path vector must satisfy C cᵢ = 0.
+    let row = vec![0.0, 1.0, 1.0, 0.0];
+    let path = DeformationPath::new(a0.clone(), a1.clone(), 3, &[row.clone()]);
+    assert_eq!(path.basis.len(), 3);
+    let z: Vec<f64> = (0..path.n_vars()).map(|i| (i as f64).sin()).collect();
+    let mut a = vec![0.0; 4];
+    path.shape_at(&z, 0.0, &mut a);
+    assert_eq!(a, a0);
+    path.shape_at(&z, 1.0, &mut a);
+    for (x, y) in a.iter().zip(&a1) {
+        assert!((x - y).abs() < 1e-15);
+    }
+    for c in path.c_vectors(&z) {
+        let r: f64 = c.iter().zip(&row).map(|(u, v)| u * v).sum();
+        assert!(r.abs() < 1e-12, "C c = {r}");
+    }
+}
+
+#[test]
+fn smoothed_max_brackets_the_max() {
+    use dlo_planner::planner::minimax::smoothed_max;
+    let u = [1.0, 3.0, 2.5, 3.0, -1.0];
+    let mut w = [0.0; 5];
+    for beta in [1.0, 10.0, 1000.0] {
+        let s = smoothed_max(&u, beta, &mut w);
+        assert!(
+            s >= 3.0 && s <= 3.0 + (5.0_f64).ln() / beta + 1e-12,
+            "{beta}: {s}"
+        );
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+}
