@@ -7,16 +7,42 @@
 
 use std::f64::consts::TAU;
 
-/// A Ritz basis with `pairs` sine/cosine pairs (`2 + 2·pairs` functions).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A Ritz basis with `pairs` sine/cosine pairs (`2 + 2·pairs` functions), optionally split at
+/// `t_a` (paper §6.2): then it also holds `H(t − t_a)·eᵢ(t)`, so that a field is
+/// `a_l·e(t)` left of `t_a` and `(a_l + b)·e(t) = a_r·e(t)` right of it; continuity at `t_a`,
+/// `b·e(t_a) = 0`, is a linear constraint of the problem (see [`Basis::continuity_row`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Basis {
     pairs: usize,
+    split: Option<f64>,
 }
 
 impl Basis {
     /// A basis with `pairs` sine/cosine pairs. The paper uses 4 (10 functions).
     pub fn new(pairs: usize) -> Self {
-        Basis { pairs }
+        Basis { pairs, split: None }
+    }
+
+    /// The same basis split at `t_a ∈ (0, 1)`: twice as many functions.
+    pub fn split_at(pairs: usize, t_a: f64) -> Self {
+        Basis {
+            pairs,
+            split: Some(t_a),
+        }
+    }
+
+    /// The split point, if any.
+    pub fn split(&self) -> Option<f64> {
+        self.split
+    }
+
+    /// Continuity at the split: the row `r` with `r · a_field = 0` (zeros on the unsplit half).
+    pub fn continuity_row(&self) -> Option<Vec<f64>> {
+        let ta = self.split?;
+        let half = 2 + 2 * self.pairs;
+        let mut row = vec![0.0; 2 * half];
+        Basis::new(self.pairs).values(ta, &mut row[half..]);
+        Some(row)
     }
 
     /// Number of sine/cosine pairs.
@@ -24,9 +50,9 @@ impl Basis {
         self.pairs
     }
 
-    /// Number of basis functions, `2 + 2·pairs`.
+    /// Number of basis functions, `2 + 2·pairs` (twice that when split).
     pub fn len(&self) -> usize {
-        2 + 2 * self.pairs
+        (2 + 2 * self.pairs) * if self.split.is_some() { 2 } else { 1 }
     }
 
     /// Always false: the basis holds at least `1` and `t`.
@@ -43,6 +69,18 @@ impl Basis {
             out[2 * i] = s;
             out[2 * i + 1] = c;
         }
+        self.mirror(t, out);
+    }
+
+    /// The split half: `H(t − t_a)` times the first half (`H(0) = 0`).
+    fn mirror(&self, t: f64, out: &mut [f64]) {
+        if let Some(ta) = self.split {
+            let half = 2 + 2 * self.pairs;
+            let on = if t > ta { 1.0 } else { 0.0 };
+            for i in 0..half {
+                out[half + i] = on * out[i];
+            }
+        }
     }
 
     /// Derivatives `de/dt` written into `out`.
@@ -55,6 +93,7 @@ impl Basis {
             out[2 * i] = w * c;
             out[2 * i + 1] = -w * s;
         }
+        self.mirror(t, out);
     }
 
     /// `Σ aᵢ eᵢ(t)` for one field's coefficients.

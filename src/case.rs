@@ -387,7 +387,24 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    build(file, path)
+    build(file, path, None)
+}
+
+/// The case of `file` with its basis split at `s_split` (paper §6.2: two coefficient sets,
+/// continuous there) and `extra` point forces added; the explicit `shape`, whose length belongs
+/// to the unsplit basis, is dropped.
+pub fn variant(
+    file: &CaseFile,
+    path: &Path,
+    s_split: Option<f64>,
+    extra: &[ForceSpec],
+) -> Result<Case, Error> {
+    let mut f = file.clone();
+    f.forces.extend(extra.iter().cloned());
+    if s_split.is_some() {
+        f.shape = None;
+    }
+    build(f, path, s_split)
 }
 
 pub(crate) struct V<'a> {
@@ -440,7 +457,7 @@ impl V<'_> {
     }
 }
 
-fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
+fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Error> {
     let v = V { path };
     let r = &file.rod;
     let l = v.positive("rod.length", r.length)?;
@@ -498,7 +515,10 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         radius,
     };
     let layout = Layout {
-        basis: Basis::new(d.basis_pairs),
+        basis: match s_split {
+            Some(sa) => Basis::split_at(d.basis_pairs, v.arc("split", sa, l)?),
+            None => Basis::new(d.basis_pairs),
+        },
         spatial: !file.planar,
         extensible: r.extensional_rigidity.is_some(),
         free_base: file.base.free,
@@ -521,6 +541,9 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     } else {
         vec![0.0, 1.0]
     };
+    if let Some(sa) = s_split {
+        points.push(sa / l);
+    }
     for (i, c) in file.constraints.iter().enumerate() {
         match c {
             ConstraintSpec::Position { s, .. } | ConstraintSpec::Orientation { s, .. } => {
@@ -738,6 +761,26 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         }
     }
 
+    if let Some(row) = layout.basis.continuity_row() {
+        let fields = [Field::Theta, Field::Phi, Field::Psi, Field::Eps];
+        let rows = fields
+            .iter()
+            .filter_map(|&f| layout.offset(f))
+            .map(|off| {
+                let r: Vec<(usize, f64)> = row
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| **c != 0.0)
+                    .map(|(i, c)| (off + i, *c))
+                    .collect();
+                (r, 0.0)
+            })
+            .collect();
+        constraints.push(Box::new(crate::constraints::LinearConstraint {
+            name: "continuity at the split".into(),
+            rows,
+        }));
+    }
     let samples: Vec<usize> = (0..=d.samples)
         .map(|j| model.boundary(j as f64 / d.samples as f64))
         .collect();

@@ -20,7 +20,7 @@ pub enum Field {
 }
 
 /// Coefficient layout of a problem.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layout {
     /// The Ritz basis shared by every field.
     pub basis: Basis,

@@ -19,6 +19,7 @@ pub mod case;
 pub mod constraints;
 pub mod energy;
 pub mod error;
+pub mod grasp;
 pub mod kinematics;
 pub mod layout;
 pub mod mcap_log;

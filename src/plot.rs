@@ -230,3 +230,49 @@ fn snapshots(frames: &[Frame], n: usize) -> Vec<&Frame> {
     }
     out
 }
+
+/// The `F_mub`–`μ` curve (paper Fig. 15) as SVG.
+pub fn plot_margin(
+    margin: &crate::grasp::Margin,
+    title: &str,
+    path: &std::path::Path,
+) -> Result<(), PlotError> {
+    let root = SVGBackend::new(path, (600, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    let mu_max = margin.mu.iter().copied().fold(0.0_f64, f64::max).max(1e-9);
+    let f_top = margin
+        .f_mub
+        .iter()
+        .copied()
+        .fold(0.0_f64, f64::max)
+        .max(1e-12)
+        * 1.1;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..mu_max * 1.05, 0.0..f_top)
+        .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("friction coefficient μ")
+        .y_desc("disturbance force margin F_mub")
+        .draw()
+        .map_err(draw_err)?;
+    let pts: Vec<(f64, f64)> = margin
+        .mu
+        .iter()
+        .copied()
+        .zip(margin.f_mub.iter().copied())
+        .collect();
+    let blue = RGBColor(25, 100, 230);
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), blue.stroke_width(2)))
+        .map_err(draw_err)?;
+    chart
+        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, blue.filled())))
+        .map_err(draw_err)?;
+    root.present().map_err(draw_err)?;
+    Ok(())
+}

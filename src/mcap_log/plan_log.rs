@@ -256,3 +256,47 @@ pub fn log_static(
     )?;
     Ok(())
 }
+
+/// Logs a margin computation: the last shape that held for every point and direction on
+/// `/grasp/held_shape` (0.1 s apart, in table order) with its limits on `/grasp/limits`.
+pub fn log_margin(
+    writer: &SharedWriter,
+    model: &Model,
+    obstacles: &[Arc<Obstacle>],
+    margin: &crate::grasp::Margin,
+) -> Result<(), LogError> {
+    let mut w = match writer.lock() {
+        Ok(w) => w,
+        Err(p) => p.into_inner(),
+    };
+    w.proto("/tf", 0, &gravity_transform(0))?;
+    if !obstacles.is_empty() {
+        w.proto(
+            "/scene/obstacles",
+            0,
+            &obstacles_update(0, obstacles, model.rod.length),
+        )?;
+    }
+    for (i, lim) in margin.table.iter().enumerate() {
+        let t = i as u64 * 100_000_000;
+        w.proto(
+            "/grasp/held_shape",
+            t,
+            &rod_update(
+                t,
+                "rod",
+                &lim.held_shape,
+                model.rod.radius,
+                color(0.1, 0.4, 0.9, 1.0),
+            ),
+        )?;
+        w.json(
+            "/grasp/limits",
+            "dlo.GraspLimit",
+            &json!({"type": "object"}),
+            t,
+            &serde_json::to_value(lim).expect("limit serialises"),
+        )?;
+    }
+    Ok(())
+}
