@@ -41,10 +41,10 @@ pub struct GraspSpec {
 }
 
 fn d_steps() -> usize {
-    12
+    10
 }
 fn d_bisect() -> usize {
-    8
+    6
 }
 
 /// A validated grasp problem with its undisturbed solution.
