@@ -47,6 +47,7 @@ pub enum PlotError {
 
 /// Reads the optimal and feasible paths from the bytes of a plan's MCAP log.
 pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
+    crate::mcap_log::writer::check_magic(bytes)?;
     let stream = mcap::MessageStream::new_with_options(
         bytes,
         enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),

@@ -323,3 +323,48 @@ fn shipped_pinned_case_prints_documented_json() {
     let r = &v["end_pose"]["rotation"];
     assert_eq!(r.as_array().unwrap().len(), 3);
 }
+
+/// The planning, margin and log commands: bad input is exit code 2 with the file and the field
+/// named, and no log is written for a case that fails validation.
+#[test]
+fn plan_margin_and_log_commands_reject_bad_input() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let no_plan = dir.join("no_plan.json");
+    std::fs::write(&no_plan, format!("{{{GOOD_ROD}}}")).unwrap();
+    let logs = dir.join("logs");
+    let logs_s = logs.to_str().unwrap();
+    let (code, out, err) = run(&["plan", no_plan.to_str().unwrap(), "--log-dir", logs_s]);
+    assert_eq!(code, 2, "{err}");
+    assert!(out.is_empty());
+    assert!(err.contains("no_plan.json") && err.contains("field `plan`"), "{err}");
+    assert!(!logs.join("no_plan.mcap").exists(), "no log for invalid input");
+    let (code, _, err) = run(&["margin", no_plan.to_str().unwrap(), "--log-dir", logs_s]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("field `grasp`"), "{err}");
+    let m0 = dir.join("m0.json");
+    std::fs::write(
+        &m0,
+        r#"{"rod": {"length": 1.0, "flexural_rigidity": 1.0},
+            "constraints": [{"type": "orientation", "s": 0.0, "theta": 0.0}],
+            "plan": {"start": {"x": 0.3, "z": 0.9}, "goal": {"x": -0.3, "z": 0.9}, "path_terms": 0}}"#,
+    )
+    .unwrap();
+    let (code, _, err) = run(&["plan", m0.to_str().unwrap(), "--log-dir", logs_s]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("plan.path_terms") && err.contains("got 0"), "{err}");
+    let not_mcap = dir.join("not.mcap");
+    std::fs::write(&not_mcap, "hello").unwrap();
+    for args in [
+        vec!["inspect", not_mcap.to_str().unwrap()],
+        vec!["recover", not_mcap.to_str().unwrap(), dir.join("fixed.mcap").to_str().unwrap()],
+        vec!["plot", not_mcap.to_str().unwrap()],
+        vec!["inspect", dir.join("missing.mcap").to_str().unwrap()],
+    ] {
+        let (code, _, err) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
+    }
+    assert!(!dir.join("fixed.mcap").exists(), "no half-written output");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -251,3 +251,33 @@ fn plot_writes_an_svg_from_a_log() {
         &svg[..200.min(svg.len())]
     );
 }
+
+/// Ctrl-C (SIGINT) finishes the log before exiting with code 130: the file is indexed.
+#[test]
+#[cfg(unix)]
+fn interrupted_plan_leaves_a_finished_log() {
+    let dir = log_dir().join("interrupted");
+    let _ = std::fs::remove_dir_all(&dir);
+    let child = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let log = dir.join("plan_paper_planar.mcap");
+    let t0 = std::time::Instant::now();
+    while std::fs::metadata(&log).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&log).unwrap();
+    let counts = check_log(&bytes);
+    assert!(counts["/rod/straight"] == 41, "{counts:?}");
+}

@@ -41,6 +41,7 @@ pub struct Inspection {
 
 /// Reads every message of `bytes`.
 pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
+    super::writer::check_magic(bytes)?;
     let stream = mcap::MessageStream::new_with_options(
         bytes,
         enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),

@@ -20,6 +20,7 @@ pub struct Recovery {
 /// Copies every readable message of `input` (the bytes of an MCAP file, complete or not) to a
 /// new, finished MCAP written on `out`.
 pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogError> {
+    super::writer::check_magic(input)?;
     let stream = mcap::MessageStream::new_with_options(
         input,
         enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),

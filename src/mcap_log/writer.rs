@@ -10,6 +10,15 @@ use std::path::Path;
 /// Chunk size: small enough that a killed run loses little, large enough to compress well.
 pub const CHUNK_BYTES: u64 = 64 * 1024;
 
+/// Fails unless `bytes` starts with the MCAP magic.
+pub fn check_magic(bytes: &[u8]) -> Result<(), LogError> {
+    if bytes.starts_with(mcap::MAGIC) {
+        Ok(())
+    } else {
+        Err(mcap::McapError::BadMagic)
+    }
+}
+
 /// The writer behind every log.
 pub struct McapWriter<W: Write + Seek> {
     inner: Option<mcap::Writer<W>>,
