@@ -337,8 +337,14 @@ fn plan_margin_and_log_commands_reject_bad_input() {
     let (code, out, err) = run(&["plan", no_plan.to_str().unwrap(), "--log-dir", logs_s]);
     assert_eq!(code, 2, "{err}");
     assert!(out.is_empty());
-    assert!(err.contains("no_plan.json") && err.contains("field `plan`"), "{err}");
-    assert!(!logs.join("no_plan.mcap").exists(), "no log for invalid input");
+    assert!(
+        err.contains("no_plan.json") && err.contains("field `plan`"),
+        "{err}"
+    );
+    assert!(
+        !logs.join("no_plan.mcap").exists(),
+        "no log for invalid input"
+    );
     let (code, _, err) = run(&["margin", no_plan.to_str().unwrap(), "--log-dir", logs_s]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("field `grasp`"), "{err}");
@@ -352,18 +358,28 @@ fn plan_margin_and_log_commands_reject_bad_input() {
     .unwrap();
     let (code, _, err) = run(&["plan", m0.to_str().unwrap(), "--log-dir", logs_s]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("plan.path_terms") && err.contains("got 0"), "{err}");
+    assert!(
+        err.contains("plan.path_terms") && err.contains("got 0"),
+        "{err}"
+    );
     let not_mcap = dir.join("not.mcap");
     std::fs::write(&not_mcap, "hello").unwrap();
     for args in [
         vec!["inspect", not_mcap.to_str().unwrap()],
-        vec!["recover", not_mcap.to_str().unwrap(), dir.join("fixed.mcap").to_str().unwrap()],
+        vec![
+            "recover",
+            not_mcap.to_str().unwrap(),
+            dir.join("fixed.mcap").to_str().unwrap(),
+        ],
         vec!["plot", not_mcap.to_str().unwrap()],
         vec!["inspect", dir.join("missing.mcap").to_str().unwrap()],
     ] {
         let (code, _, err) = run(&args);
         assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{err}"
+        );
     }
     assert!(!dir.join("fixed.mcap").exists(), "no half-written output");
     let _ = std::fs::remove_dir_all(&dir);

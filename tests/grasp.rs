@@ -44,7 +44,11 @@ fn initial_grasping_forces_match_the_elastica() {
         let exact = common::pinned_elastica_load(ratio) / (100.0 * 100.0);
         for f in &g.initial_forces {
             let rel = (f.normal - exact).abs() / exact;
-            assert!(rel < 1e-3, "l = {ratio} L: {} vs {exact} ({rel:e})", f.normal);
+            assert!(
+                rel < 1e-3,
+                "l = {ratio} L: {} vs {exact} ({rel:e})",
+                f.normal
+            );
             // Symmetric arch: no tangential force, to solver precision.
             assert!(f.tangential < 1e-6 * exact, "{}", f.tangential);
         }
@@ -69,7 +73,11 @@ fn grasp_a_loses_the_right_end_between_1_4_and_1_7_e_minus_3() {
 fn pinch_holds_at_2_e_minus_3() {
     let g = grasp_b("{\"preload\": 1.10e-3}");
     let lim = g.limit(75.0, N_PAPER).unwrap();
-    assert!(lim.f_contact_lost.is_none_or(|f| f > 2.0e-3), "{:?}", lim.f_contact_lost);
+    assert!(
+        lim.f_contact_lost.is_none_or(|f| f > 2.0e-3),
+        "{:?}",
+        lim.f_contact_lost
+    );
 }
 
 /// Fig. 15's trends on a 5 × 6 grid: the margin grows with μ; it grows with r0 (grasp (a) at
@@ -88,14 +96,17 @@ fn margin_grows_with_mu_and_r0_and_pinch_is_more_stable() {
     }
     for k in 0..3 {
         assert!(
-            margins[0].f_mub[k] <= margins[1].f_mub[k] && margins[1].f_mub[k] <= margins[2].f_mub[k],
+            margins[0].f_mub[k] <= margins[1].f_mub[k]
+                && margins[1].f_mub[k] <= margins[2].f_mub[k],
             "μ index {k}: {:?} {:?} {:?}",
             margins[0].f_mub,
             margins[1].f_mub,
             margins[2].f_mub
         );
     }
-    let b = grasp_b(&grid.replace("{", "{\"preload\": 1.0985e-3, ")).margin(&|_, _| {}).unwrap();
+    let b = grasp_b(&grid.replace("{", "{\"preload\": 1.0985e-3, "))
+        .margin(&|_, _| {})
+        .unwrap();
     for k in 0..3 {
         assert!(
             b.f_mub[k] > margins[1].f_mub[k],
@@ -140,7 +151,11 @@ fn split_problem_gradient_matches_finite_differences() {
         ap[i] += h;
         am[i] -= h;
         let fd = (lag(&mut p, &ap) - lag(&mut p, &am)) / (2.0 * h);
-        assert!((fd - grad[i]).abs() < 1e-6 * scale, "coefficient {i}: {fd} vs {}", grad[i]);
+        assert!(
+            (fd - grad[i]).abs() < 1e-6 * scale,
+            "coefficient {i}: {fd} vs {}",
+            grad[i]
+        );
     }
 }
 

@@ -276,8 +276,55 @@ fn interrupted_plan_leaves_a_finished_log() {
         .unwrap();
     assert!(status.success());
     let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(130), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bytes = std::fs::read(&log).unwrap();
     let counts = check_log(&bytes);
     assert!(counts["/rod/straight"] == 41, "{counts:?}");
+}
+
+/// `dlo margin --json --plot` prints the documented keys, draws the curve and logs every held
+/// shape.
+#[test]
+fn margin_command_reports_plots_and_logs() {
+    let dir = log_dir().join("margin");
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args([
+            "margin",
+            "planning_cases/grasp_b_pinch.json",
+            "--json",
+            "--plot",
+            "--log-dir",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "f_mub",
+        "s_a",
+        "direction",
+        "timing_s",
+        "table",
+        "mu",
+        "capped",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    let table = v["table"].as_array().unwrap();
+    assert_eq!(table.len(), 81);
+    let svg = std::fs::read_to_string(dir.join("grasp_b_pinch.svg")).unwrap();
+    assert!(svg.starts_with("<svg"));
+    let counts = check_log(&std::fs::read(dir.join("grasp_b_pinch.mcap")).unwrap());
+    assert_eq!(counts["/grasp/held_shape"], 81);
+    assert_eq!(counts["/grasp/limits"], 81);
 }

@@ -361,11 +361,12 @@ impl Grasp {
         };
         prev = self.solve_at(&mut p, 0.0, n, &prev);
         let mut unconverged = 0;
-        let state = |p: &StaticProblem, sol: &StaticSolution| -> (Vec<ContactForce>, Option<usize>) {
-            let forces = contact_forces(p, &self.fingers, &sol.lambda, self.preload);
-            let lost = forces.iter().position(|c| c.normal <= 1e-9 * scale);
-            (forces, lost)
-        };
+        let state =
+            |p: &StaticProblem, sol: &StaticSolution| -> (Vec<ContactForce>, Option<usize>) {
+                let forces = contact_forces(p, &self.fingers, &sol.lambda, self.preload);
+                let lost = forces.iter().position(|c| c.normal <= 1e-9 * scale);
+                (forces, lost)
+            };
         let mut samples: Vec<(f64, Vec<ContactForce>)> = vec![(0.0, state(&p, &prev).0)];
         let mut lost_at: Option<(f64, f64, usize)> = None; // (good f, bad f, finger)
         if let (_, Some(i)) = state(&p, &prev) {

@@ -49,7 +49,8 @@ fn metrics_schema() -> serde_json::Value {
                 "gravitational": {"type": "number"}, "work": {"type": "number"}}},
             "clearance": {"type": ["number", "null"]},
             "deviation": {"type": ["number", "null"]},
-            "stable": {"type": ["boolean", "null"]}
+            "stable": {"type": ["boolean", "null"]},
+            "violation": {"type": ["number", "null"]}
         }
     })
 }
@@ -155,6 +156,7 @@ impl PlanObserver for PlanLog {
             "clearance": r.clearance,
             "deviation": r.deviation,
             "stable": r.stable,
+            "violation": r.violation,
         });
         let reactions =
             (!r.reactions.is_empty()).then(|| json!({"k": r.k, "reactions": r.reactions}));

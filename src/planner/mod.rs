@@ -491,6 +491,7 @@ impl Planner {
                     deviation: None,
                     stable: sol.stable,
                     reactions: &sol.reactions,
+                    violation: Some(sol.max_violation),
                 },
             );
         }
@@ -528,6 +529,7 @@ impl Planner {
                         deviation: None,
                         stable: None,
                         reactions: &[],
+                        violation: None,
                     },
                 );
             }

@@ -40,6 +40,8 @@ pub struct ShapeRecord<'a> {
     pub stable: Option<bool>,
     /// Reactions (replay only).
     pub reactions: &'a [Reaction],
+    /// Constraint violation of the static solve (endpoints and replay; units of L).
+    pub violation: Option<f64>,
 }
 
 /// Progress of the minimax optimiser after one outer iteration.

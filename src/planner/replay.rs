@@ -179,6 +179,7 @@ pub fn replay(
                 deviation: None,
                 stable: None,
                 reactions: &[],
+                violation: None,
             },
         );
         observer.shape(
@@ -192,6 +193,7 @@ pub fn replay(
                 deviation: Some(d),
                 stable: st.sol.stable,
                 reactions: &st.sol.reactions,
+                violation: Some(st.sol.max_violation),
             },
         );
     };
