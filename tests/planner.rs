@@ -235,7 +235,9 @@ fn bad_planning_inputs_name_the_field() {
     ];
     for (text, field) in cases {
         let c = case::parse(&text, Path::new("bad.json")).unwrap();
-        let e = Planner::from_case(&c).err().expect("must be rejected");
+        let Err(e) = Planner::from_case(&c) else {
+            panic!("{field}: must be rejected")
+        };
         let msg = e.to_string();
         assert!(
             msg.contains(&format!("field `{field}")) && msg.contains("bad.json"),

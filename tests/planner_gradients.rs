@@ -79,7 +79,7 @@ fn path_ends_on_its_shapes_and_keeps_linear_conditions() {
     let a1 = vec![0.3, -1.0, 0.1, 0.4];
     // A linear condition on a[1] + a[2]: every path vector must satisfy C cᵢ = 0.
     let row = vec![0.0, 1.0, 1.0, 0.0];
-    let path = DeformationPath::new(a0.clone(), a1.clone(), 3, &[row.clone()]);
+    let path = DeformationPath::new(a0.clone(), a1.clone(), 3, std::slice::from_ref(&row));
     assert_eq!(path.basis.len(), 3);
     let z: Vec<f64> = (0..path.n_vars()).map(|i| (i as f64).sin()).collect();
     let mut a = vec![0.0; 4];
