@@ -92,11 +92,29 @@ fn replay_reproduces_start_and_goal() {
     assert!(r.replay.all_stable);
 }
 
-/// On the paper's example the replay follows the plan within 2 % of L except near the end of
-/// the swing past the block's corner (see the README); the numbers are asserted as measured.
+/// On the paper's example (with four path terms) the replay by the end pose coincides with the
+/// plan within the 2 % tolerance, every replayed shape stable and every solve converged.
 #[test]
-fn paper_replay_agrees_away_from_the_final_swing() {
+fn paper_replay_coincides() {
     let (_, r) = paper();
+    assert!(r.replay.all_converged && r.replay.snaps.is_empty());
+    assert!(r.replay.max_deviation_over_l <= 0.02, "{}", r.replay.max_deviation_over_l);
+    assert!(r.replay.coincide);
+}
+
+/// With the paper's three path terms the replay follows the plan within 2 % of L up to
+/// k = 0.9 and departs by more in the last swing past the block's corner (measured 2.2 %; the
+/// README discusses it): the verdict is honest either way, so both bounds are asserted.
+#[test]
+fn paper_three_terms_depart_only_in_the_last_swing() {
+    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["plan"]["path_terms"] = serde_json::json!(3);
+    v["plan"]["safety_margin"] = serde_json::json!(0.01);
+    let c = case::parse(&v.to_string(), Path::new("paper_m3.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let r = p.run(&mut Silent);
+    assert_eq!(r.status, PlanStatus::Planned);
     let away: f64 = r
         .replay
         .steps
@@ -105,11 +123,7 @@ fn paper_replay_agrees_away_from_the_final_swing() {
         .map(|s| s.deviation)
         .fold(0.0, f64::max);
     assert!(away < 0.02, "max deviation for k ≤ 0.9: {away}");
-    assert!(
-        r.replay.max_deviation_over_l < 0.05,
-        "{}",
-        r.replay.max_deviation_over_l
-    );
+    assert!(r.replay.max_deviation_over_l < 0.05, "{}", r.replay.max_deviation_over_l);
 }
 
 fn plan_text(start: &str, goal: &str, obstacles: &str) -> String {
