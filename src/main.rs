@@ -445,6 +445,14 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         }
     }
     match (result.status, result.replay.coincide) {
+        (PlanStatus::Collision, _) if result.min_clearance.is_none_or(|c| c >= 0.0) => {
+            let (gap, k) = result.verification.self_contact.unwrap_or((0.0, 0.0));
+            eprintln!(
+                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3})",
+                path.display()
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
         (PlanStatus::Collision, _) => {
             eprintln!(
                 "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4})",

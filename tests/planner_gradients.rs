@@ -109,3 +109,29 @@ fn smoothed_max_brackets_the_max() {
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
     }
 }
+
+/// The verification grid checks self-contact: a planar curl turning by 7 rad (more than a full
+/// circle) crosses itself; one turning by 3 rad does not.
+#[test]
+fn verification_finds_a_rod_crossing_itself() {
+    use dlo_planner::energy::Objective;
+    use dlo_planner::path::DeformationPath;
+    use dlo_planner::planner::verify::{fine_model, verify_with};
+    let text = r#"{ "rod": { "length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005 },
+                    "self_contact": true }"#;
+    let c = case::parse(text, Path::new("curl.json")).unwrap();
+    let fine = fine_model(&c.problem.model, 256, 4);
+    let curl = |turn: f64| {
+        let mut a = vec![0.0; c.problem.model.n()];
+        a[1] = turn;
+        a
+    };
+    for (turn, crosses) in [(7.0, true), (3.0, false)] {
+        let path = DeformationPath::new(curl(turn), curl(turn), 1, &[]);
+        let z = vec![0.0; path.n_vars()];
+        let v = verify_with(&fine, &path, &z, 3, &[], Objective::Internal, true);
+        let (gap, _) = v.self_contact.unwrap();
+        assert_eq!(gap < 0.0, crosses, "turn {turn}: gap {gap}");
+        assert_eq!(v.collision_free(1e-9), !crosses);
+    }
+}

@@ -15,7 +15,7 @@ pub use linear::LinearConstraint;
 pub use obstacle::ObstacleConstraint;
 pub use orientation::{Angle, OrientationConstraint};
 pub use position::{Bound, PositionConstraint, RelativePositionConstraint};
-pub use self_contact::SelfContactConstraint;
+pub use self_contact::{SelfContactConstraint, segment_distance};
 
 use crate::kinematics::Shape;
 use crate::model::Model;

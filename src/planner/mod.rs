@@ -30,7 +30,7 @@ use replay::{Replay, ReplayOptions, replay};
 use serde::Serialize;
 use spec::{End, PlanOptions};
 use std::sync::Arc;
-use verify::{Verification, fine_model, verify};
+use verify::{Verification, fine_model, verify_with};
 
 /// A planning problem ready to run: the held end's conditions, the obstacles, and the two
 /// solved end shapes.
@@ -295,6 +295,14 @@ impl Planner {
         })
     }
 
+    /// Whether the case enforces self-contact.
+    pub fn has_self_contact(&self) -> bool {
+        self.base
+            .constraints
+            .iter()
+            .any(|c| c.as_any().is::<crate::constraints::SelfContactConstraint>())
+    }
+
     /// The straight-line path `c = 0` and the path's unknowns' count.
     pub fn path(&self) -> DeformationPath {
         DeformationPath::new(
@@ -499,13 +507,14 @@ impl Planner {
         let path = self.path();
         let nv = path.n_vars();
         let fine = fine_model(model, self.options.verify_s, 4);
-        let straight = verify(
+        let straight = verify_with(
             &fine,
             &path,
             &vec![0.0; nv],
             self.options.verify_k,
             &self.obstacles,
             self.base.objective,
+            self.has_self_contact(),
         );
         {
             let mut a = vec![0.0; path.n()];
@@ -599,13 +608,14 @@ impl Planner {
             .expect("at least one start");
         let mut chosen = runs[best].clone();
         observer.phase("verify");
-        let mut ver = verify(
+        let mut ver = verify_with(
             &fine,
             &path,
             &chosen.z,
             self.options.verify_k,
             &self.obstacles,
             self.base.objective,
+            self.has_self_contact(),
         );
         // Tunnelling between samples: add the verification grid's worst k (and its neighbours
         // on that grid) to the optimiser's samples and optimise again from the current path.
@@ -638,13 +648,14 @@ impl Planner {
                 ..r
             };
             observer.phase("verify");
-            ver = verify(
+            ver = verify_with(
                 &fine,
                 &path,
                 &chosen.z,
                 self.options.verify_k,
                 &self.obstacles,
                 self.base.objective,
+                self.has_self_contact(),
             );
         }
         let chosen = &chosen;

@@ -59,12 +59,16 @@ pub struct Verification {
     pub obstacles: Vec<ObstacleClearance>,
     /// Smallest over obstacles (case units), `None` without obstacles.
     pub min_clearance: Option<f64>,
+    /// With self-contact: the smallest gap `d − 2r` between chords of the rod at least `2r`
+    /// apart along it (case units; 64 chords per shape), and the `k` where it occurs.
+    pub self_contact: Option<(f64, f64)>,
 }
 
 impl Verification {
     /// Whether no obstacle is penetrated (within `tol`, case units).
     pub fn collision_free(&self, tol: f64) -> bool {
         self.min_clearance.is_none_or(|c| c >= -tol)
+            && self.self_contact.is_none_or(|(g, _)| g >= -tol)
     }
 }
 
@@ -77,6 +81,35 @@ pub fn verify(
     obstacles: &[Arc<Obstacle>],
     objective: Objective,
 ) -> Verification {
+    verify_with(fine, path, z, k_samples, obstacles, objective, false)
+}
+
+/// [`verify`], also checking self-contact when `self_contact` is set.
+pub fn verify_with(
+    fine: &Model,
+    path: &DeformationPath,
+    z: &[f64],
+    k_samples: usize,
+    obstacles: &[Arc<Obstacle>],
+    objective: Objective,
+    self_contact: bool,
+) -> Verification {
+    // 64 chords through every fourth-or-so boundary of the fine grid.
+    let nb = fine.mesh.boundaries.len();
+    let stride = ((nb - 1) / 64).max(1);
+    let chord_pts: Vec<usize> = (0..nb).step_by(stride).collect();
+    let chord_t: Vec<f64> = chord_pts.iter().map(|&b| fine.mesh.boundaries[b]).collect();
+    let pairs = if self_contact {
+        crate::constraints::SelfContactConstraint::new(
+            chord_pts.clone(),
+            &chord_t,
+            2.0 * fine.rod.radius / fine.rod.length,
+        )
+        .pairs
+    } else {
+        Vec::new()
+    };
+    let mut worst_self: Option<(f64, f64)> = None;
     let l = fine.rod.length;
     let r = fine.rod.radius;
     let unit = fine.rod.energy_unit();
@@ -105,6 +138,15 @@ pub fn verify(
                 Objective::Potential => t.potential(),
             },
         );
+        for &(i, j) in &pairs {
+            let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
+            let (_, _, d) =
+                crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
+            let gap = d - 2.0 * r;
+            if worst_self.is_none_or(|(g, _)| gap < g) {
+                worst_self = Some((gap, k));
+            }
+        }
         for (o, w) in obstacles.iter().zip(worst.iter_mut()) {
             for (b, p) in shape.positions.iter().enumerate() {
                 let (d, _) = o.signed_distance(p.map(|v| v * l));
@@ -129,5 +171,6 @@ pub fn verify(
         ks,
         obstacles: worst,
         min_clearance,
+        self_contact: worst_self,
     }
 }
