@@ -98,7 +98,11 @@ fn replay_reproduces_start_and_goal() {
 fn paper_replay_coincides() {
     let (_, r) = paper();
     assert!(r.replay.all_converged && r.replay.snaps.is_empty());
-    assert!(r.replay.max_deviation_over_l <= 0.02, "{}", r.replay.max_deviation_over_l);
+    assert!(
+        r.replay.max_deviation_over_l <= 0.02,
+        "{}",
+        r.replay.max_deviation_over_l
+    );
     assert!(r.replay.coincide);
 }
 
@@ -123,7 +127,11 @@ fn paper_three_terms_depart_only_in_the_last_swing() {
         .map(|s| s.deviation)
         .fold(0.0, f64::max);
     assert!(away < 0.02, "max deviation for k ≤ 0.9: {away}");
-    assert!(r.replay.max_deviation_over_l < 0.05, "{}", r.replay.max_deviation_over_l);
+    assert!(
+        r.replay.max_deviation_over_l < 0.05,
+        "{}",
+        r.replay.max_deviation_over_l
+    );
 }
 
 fn plan_text(start: &str, goal: &str, obstacles: &str) -> String {

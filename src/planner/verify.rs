@@ -140,8 +140,7 @@ pub fn verify_with(
         );
         for &(i, j) in &pairs {
             let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
-            let (_, _, d) =
-                crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
+            let (_, _, d) = crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
             let gap = d - 2.0 * r;
             if worst_self.is_none_or(|(g, _)| gap < g) {
                 worst_self = Some((gap, k));
