@@ -27,6 +27,14 @@ pub struct EnergyTerms {
 }
 
 impl EnergyTerms {
+    /// The energy `objective` names: `V` or `U`.
+    pub fn value(&self, objective: Objective) -> f64 {
+        match objective {
+            Objective::Internal => self.internal(),
+            Objective::Potential => self.potential(),
+        }
+    }
+
     /// Potential energy `U` (eq. 7).
     pub fn potential(&self) -> f64 {
         self.flexural + self.torsional + self.extensional + self.gravitational
@@ -156,10 +164,7 @@ impl Model {
     ) -> f64 {
         self.evaluate_into(a, shape);
         grad.iter_mut().for_each(|g| *g = 0.0);
-        let t = self.energy(a, shape, objective, Some(grad));
-        match objective {
-            Objective::Internal => t.internal(),
-            Objective::Potential => t.potential(),
-        }
+        self.energy(a, shape, objective, Some(grad))
+            .value(objective)
     }
 }

@@ -167,10 +167,7 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
     if ACTIVE_LOG.set(shared.clone()).is_ok() {
         let _ = ctrlc::set_handler(|| {
             if let Some(w) = ACTIVE_LOG.get() {
-                let mut w = match w.lock() {
-                    Ok(w) => w,
-                    Err(p) => p.into_inner(),
-                };
+                let mut w = dlo_planner::mcap_log::lock(w);
                 let _ = w.finish();
             }
             eprintln!("interrupted: the log was finished and is readable");
@@ -182,11 +179,7 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
 
 /// Finishes a log; reports failure as exit code 1.
 fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
-    let mut g = match w.lock() {
-        Ok(g) => g,
-        Err(p) => p.into_inner(),
-    };
-    g.finish().map_err(|e| {
+    dlo_planner::mcap_log::lock(w).finish().map_err(|e| {
         eprintln!("error: {}: cannot finish the log: {e}", path.display());
         ExitCode::from(EXIT_OUTPUT)
     })

@@ -128,10 +128,10 @@ pub fn plot(frames: &PlanFrames, title: &str, path: &std::path::Path) -> Result<
     let blue = RGBColor(25, 100, 230);
     let red = RGBColor(230, 50, 50);
 
-    // Snapshots at about seven values of k.
-    {
-        let mut chart = ChartBuilder::on(&panels[0])
-            .caption("shapes (blue optimal, red feasible)", ("sans-serif", 14))
+    // Both shape panels show the paper's plane: horizontal z, vertical x.
+    let plane = |area, caption| -> Result<_, PlotError> {
+        let mut chart = ChartBuilder::on(area)
+            .caption(caption, ("sans-serif", 14))
             .margin(10)
             .x_label_area_size(30)
             .y_label_area_size(40)
@@ -143,6 +143,11 @@ pub fn plot(frames: &PlanFrames, title: &str, path: &std::path::Path) -> Result<
             .y_desc("x")
             .draw()
             .map_err(draw_err)?;
+        Ok(chart)
+    };
+    // Snapshots at about seven values of k.
+    {
+        let mut chart = plane(&panels[0], "shapes (blue optimal, red feasible)")?;
         for (frames, colour) in [(&frames.optimal, blue), (&frames.feasible, red)] {
             for f in snapshots(frames, 7) {
                 chart
@@ -156,19 +161,7 @@ pub fn plot(frames: &PlanFrames, title: &str, path: &std::path::Path) -> Result<
     }
     // End-point trajectory.
     {
-        let mut chart = ChartBuilder::on(&panels[1])
-            .caption("controlled end P(L)", ("sans-serif", 14))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(40)
-            .build_cartesian_2d((zmin - pad)..(zmax + pad), (xmin - pad)..(xmax + pad))
-            .map_err(draw_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("z")
-            .y_desc("x")
-            .draw()
-            .map_err(draw_err)?;
+        let mut chart = plane(&panels[1], "controlled end P(L)")?;
         for (frames, colour) in [(&frames.optimal, blue), (&frames.feasible, red)] {
             chart
                 .draw_series(LineSeries::new(

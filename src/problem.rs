@@ -90,10 +90,7 @@ impl Nlp for StaticProblem {
                 &mut c[self.offsets[k]..self.offsets[k + 1]],
             );
         }
-        match self.objective {
-            Objective::Internal => self.terms.internal(),
-            Objective::Potential => self.terms.potential(),
-        }
+        self.terms.value(self.objective)
     }
     fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
         g.copy_from_slice(&self.grad_f);

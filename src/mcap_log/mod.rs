@@ -8,5 +8,5 @@ pub mod recover;
 pub mod scene;
 pub mod writer;
 
-pub use plan_log::{PlanLog, SharedWriter, log_margin, log_static};
+pub use plan_log::{PlanLog, SharedWriter, lock, log_margin, log_static};
 pub use writer::{LogError, McapWriter};

@@ -29,6 +29,14 @@ use std::sync::{Arc, Mutex};
 /// A log file shared with a signal handler (which finishes it on Ctrl-C).
 pub type SharedWriter = Arc<Mutex<McapWriter<BufWriter<File>>>>;
 
+/// Locks a shared log; a writer whose holder panicked is still usable (it only appends).
+pub fn lock(w: &SharedWriter) -> std::sync::MutexGuard<'_, McapWriter<BufWriter<File>>> {
+    match w.lock() {
+        Ok(g) => g,
+        Err(p) => p.into_inner(),
+    }
+}
+
 /// Writes the planner's shapes to an MCAP file.
 pub struct PlanLog {
     writer: SharedWriter,
@@ -81,10 +89,7 @@ impl PlanLog {
         if self.error.is_some() {
             return;
         }
-        let mut w = match self.writer.lock() {
-            Ok(w) => w,
-            Err(p) => p.into_inner(),
-        };
+        let mut w = lock(&self.writer);
         if w.is_finished() {
             return;
         }
@@ -225,10 +230,7 @@ pub fn log_static(
     a: &[f64],
     metrics: &serde_json::Value,
 ) -> Result<(), LogError> {
-    let mut w = match writer.lock() {
-        Ok(w) => w,
-        Err(p) => p.into_inner(),
-    };
+    let mut w = lock(writer);
     let pts = rod_points(model, a);
     let end = *pts.last().expect("at least two boundaries");
     w.proto("/tf", 0, &gravity_transform(0))?;
@@ -267,10 +269,7 @@ pub fn log_margin(
     obstacles: &[Arc<Obstacle>],
     margin: &crate::grasp::Margin,
 ) -> Result<(), LogError> {
-    let mut w = match writer.lock() {
-        Ok(w) => w,
-        Err(p) => p.into_inner(),
-    };
+    let mut w = lock(writer);
     w.proto("/tf", 0, &gravity_transform(0))?;
     if !obstacles.is_empty() {
         w.proto(

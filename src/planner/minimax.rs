@@ -180,10 +180,7 @@ impl Nlp for MinimaxProblem {
                 self.objective,
                 Some(&mut self.gu[j]),
             );
-            self.u[j] = match self.objective {
-                Objective::Internal => t.internal(),
-                Objective::Potential => t.potential(),
-            };
+            self.u[j] = t.value(self.objective);
             if k > 0.0 && k < 1.0 {
                 for (b, blk) in self.blocks.iter().enumerate() {
                     blk.values(

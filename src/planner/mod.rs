@@ -507,15 +507,19 @@ impl Planner {
         let path = self.path();
         let nv = path.n_vars();
         let fine = fine_model(model, self.options.verify_s, 4);
-        let straight = verify_with(
-            &fine,
-            &path,
-            &vec![0.0; nv],
-            self.options.verify_k,
-            &self.obstacles,
-            self.base.objective,
-            self.has_self_contact(),
-        );
+        let self_contact = self.has_self_contact();
+        let check = |z: &[f64]| {
+            verify_with(
+                &fine,
+                &path,
+                z,
+                self.options.verify_k,
+                &self.obstacles,
+                self.base.objective,
+                self_contact,
+            )
+        };
+        let straight = check(&vec![0.0; nv]);
         {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();
@@ -608,15 +612,7 @@ impl Planner {
             .expect("at least one start");
         let mut chosen = runs[best].clone();
         observer.phase("verify");
-        let mut ver = verify_with(
-            &fine,
-            &path,
-            &chosen.z,
-            self.options.verify_k,
-            &self.obstacles,
-            self.base.objective,
-            self.has_self_contact(),
-        );
+        let mut ver = check(&chosen.z);
         // Tunnelling between samples: add the verification grid's worst k (and its neighbours
         // on that grid) to the optimiser's samples and optimise again from the current path.
         let tol = 1e-6 * model.rod.length;
@@ -627,8 +623,14 @@ impl Planner {
             if ver.collision_free(tol) {
                 break;
             }
-            for o in ver.obstacles.iter().filter(|o| o.clearance < -tol) {
-                for k in [o.k - h, o.k, o.k + h] {
+            let worst_k = ver
+                .obstacles
+                .iter()
+                .filter(|o| o.clearance < -tol)
+                .map(|o| o.k)
+                .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k));
+            for kw in worst_k.collect::<Vec<_>>() {
+                for k in [kw - h, kw, kw + h] {
                     if k > 0.0 && k < 1.0 && !ks.iter().any(|&q| (q - k).abs() < 0.25 * h) {
                         ks.push(k);
                         added.push(k);
@@ -648,15 +650,7 @@ impl Planner {
                 ..r
             };
             observer.phase("verify");
-            ver = verify_with(
-                &fine,
-                &path,
-                &chosen.z,
-                self.options.verify_k,
-                &self.obstacles,
-                self.base.objective,
-                self.has_self_contact(),
-            );
+            ver = check(&chosen.z);
         }
         let chosen = &chosen;
         let t_plan = t0.elapsed().as_secs_f64();

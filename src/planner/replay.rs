@@ -111,10 +111,7 @@ pub fn replay(
         path.shape_at(z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
         let u = model.energy(&a, &shape, base.objective, None).scaled(unit);
-        let u = match base.objective {
-            crate::energy::Objective::Internal => u.internal(),
-            crate::energy::Objective::Potential => u.potential(),
-        };
+        let u = u.value(base.objective);
         (a.clone(), shape.positions.clone(), u)
     };
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
@@ -150,10 +147,7 @@ pub fn replay(
             k: st.k,
             deviation: d,
             u_optimal: target.2,
-            u_feasible: match base.objective {
-                crate::energy::Objective::Internal => st.sol.energy.internal(),
-                crate::energy::Objective::Potential => st.sol.energy.potential(),
-            },
+            u_feasible: st.sol.energy.value(base.objective),
             converged: st.sol.status == SolveStatus::Converged,
             status: st.sol.status,
             kkt_residual: st.sol.kkt_residual,

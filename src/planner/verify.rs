@@ -132,12 +132,7 @@ pub fn verify_with(
         path.shape_at(z, k, &mut a);
         fine.evaluate_into(&a, &mut shape);
         let t = fine.energy(&a, &shape, objective, None);
-        energies.push(
-            unit * match objective {
-                Objective::Internal => t.internal(),
-                Objective::Potential => t.potential(),
-            },
-        );
+        energies.push(unit * t.value(objective));
         for &(i, j) in &pairs {
             let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
             let (_, _, d) = crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
