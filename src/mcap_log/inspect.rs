@@ -41,23 +41,10 @@ pub struct Inspection {
 
 /// Reads every message of `bytes`.
 pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
-    super::writer::check_magic(bytes)?;
-    let stream = mcap::MessageStream::new_with_options(
-        bytes,
-        enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),
-    )?;
     let mut topics: BTreeMap<String, TopicSummary> = BTreeMap::new();
     let mut messages = 0;
     let (mut start, mut end): (Option<u64>, Option<u64>) = (None, None);
-    let mut stopped_at = None;
-    for m in stream {
-        let m = match m {
-            Ok(m) => m,
-            Err(e) => {
-                stopped_at = Some(e.to_string());
-                break;
-            }
-        };
+    let stopped_at = super::writer::for_each_readable(bytes, |m| {
         let t = topics
             .entry(m.channel.topic.clone())
             .or_insert_with(|| TopicSummary {
@@ -79,7 +66,8 @@ pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
         messages += 1;
         start = Some(start.map_or(m.log_time, |s| s.min(m.log_time)));
         end = Some(end.map_or(m.log_time, |e| e.max(m.log_time)));
-    }
+        Ok(())
+    })?;
     Ok(Inspection {
         topics,
         messages,

@@ -37,6 +37,23 @@ pub fn lock(w: &SharedWriter) -> std::sync::MutexGuard<'_, McapWriter<BufWriter<
     }
 }
 
+/// The scene every log starts with at time 0: the gravity transform and the obstacles.
+fn scene_start(
+    w: &mut McapWriter<BufWriter<File>>,
+    obstacles: &[Arc<Obstacle>],
+    length: f64,
+) -> Result<(), LogError> {
+    w.proto("/tf", 0, &gravity_transform(0))?;
+    if !obstacles.is_empty() {
+        w.proto(
+            "/scene/obstacles",
+            0,
+            &obstacles_update(0, obstacles, length),
+        )?;
+    }
+    Ok(())
+}
+
 /// Writes the planner's shapes to an MCAP file.
 pub struct PlanLog {
     writer: SharedWriter,
@@ -125,10 +142,7 @@ impl PlanObserver for PlanLog {
         let obstacles = self.obstacles.clone();
         let l = model.rod.length;
         self.with(|w| {
-            w.proto("/tf", 0, &gravity_transform(0))?;
-            if !obstacles.is_empty() {
-                w.proto("/scene/obstacles", 0, &obstacles_update(0, &obstacles, l))?;
-            }
+            scene_start(w, &obstacles, l)?;
             w.flush()
         });
     }
@@ -233,14 +247,7 @@ pub fn log_static(
     let mut w = lock(writer);
     let pts = rod_points(model, a);
     let end = *pts.last().expect("at least two boundaries");
-    w.proto("/tf", 0, &gravity_transform(0))?;
-    if !obstacles.is_empty() {
-        w.proto(
-            "/scene/obstacles",
-            0,
-            &obstacles_update(0, obstacles, model.rod.length),
-        )?;
-    }
+    scene_start(&mut w, obstacles, model.rod.length)?;
     w.proto(
         "/rod/shape",
         0,
@@ -270,14 +277,7 @@ pub fn log_margin(
     margin: &crate::grasp::Margin,
 ) -> Result<(), LogError> {
     let mut w = lock(writer);
-    w.proto("/tf", 0, &gravity_transform(0))?;
-    if !obstacles.is_empty() {
-        w.proto(
-            "/scene/obstacles",
-            0,
-            &obstacles_update(0, obstacles, model.rod.length),
-        )?;
-    }
+    scene_start(&mut w, obstacles, model.rod.length)?;
     for (i, lim) in margin.table.iter().enumerate() {
         let t = i as u64 * 100_000_000;
         w.proto(

@@ -21,10 +21,6 @@ pub struct Recovery {
 /// new, finished MCAP written on `out`.
 pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogError> {
     super::writer::check_magic(input)?;
-    let stream = mcap::MessageStream::new_with_options(
-        input,
-        enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),
-    )?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .chunk_size(Some(super::writer::CHUNK_BYTES))
@@ -33,15 +29,7 @@ pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogErr
     let mut channels: HashMap<u16, u16> = HashMap::new();
     let mut schemas: HashMap<u16, u16> = HashMap::new();
     let mut messages = 0;
-    let mut stopped_at = None;
-    for m in stream {
-        let m = match m {
-            Ok(m) => m,
-            Err(e) => {
-                stopped_at = Some(e.to_string());
-                break;
-            }
-        };
+    let stopped_at = super::writer::for_each_readable(input, |m| {
         let ch = &m.channel;
         let id = match channels.get(&ch.id) {
             Some(&id) => id,
@@ -72,7 +60,8 @@ pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogErr
             &m.data,
         )?;
         messages += 1;
-    }
+        Ok(())
+    })?;
     w.finish()?;
     let complete =
         mcap::read::footer(input).is_ok() && matches!(mcap::Summary::read(input), Ok(Some(_)));
