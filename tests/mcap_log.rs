@@ -168,27 +168,34 @@ fn unfinished_log_is_recovered() {
     std::fs::write(log_dir().join("recovered_unit.mcap"), &fixed).unwrap();
 }
 
+/// Starts `dlo plan` on the paper case with its log in `target/test-logs/<sub>/` and returns
+/// once the chunk with the straight-line path is on disk (closed when optimisation starts,
+/// about 4 KiB in): the run is then mid-way.
+#[cfg(unix)]
+fn plan_until_first_chunks(sub: &str) -> (std::process::Child, PathBuf) {
+    let dir = log_dir().join(sub);
+    let _ = std::fs::remove_dir_all(&dir);
+    let child = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let log = dir.join("plan_paper_planar.mcap");
+    let t0 = std::time::Instant::now();
+    while std::fs::metadata(&log).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    (child, log)
+}
+
 /// A real run killed with SIGKILL mid-way leaves a file whose finished chunks `dlo recover`
 /// turns into an indexed log.
 #[test]
 #[cfg(unix)]
 fn killed_plan_is_recovered_by_the_cli() {
-    let dir = log_dir().join("killed");
-    let _ = std::fs::remove_dir_all(&dir);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
-        .arg(&dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let broken = dir.join("plan_paper_planar.mcap");
-    // Wait until the chunk with the straight-line path is on disk (closed when optimisation
-    // starts, about 4 KiB in), then kill.
-    let t0 = std::time::Instant::now();
-    while std::fs::metadata(&broken).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let (mut child, broken) = plan_until_first_chunks("killed");
     child.kill().unwrap();
     let status = child.wait().unwrap();
     assert!(!status.success(), "the run was killed before it finished");
@@ -256,20 +263,7 @@ fn plot_writes_an_svg_from_a_log() {
 #[test]
 #[cfg(unix)]
 fn interrupted_plan_leaves_a_finished_log() {
-    let dir = log_dir().join("interrupted");
-    let _ = std::fs::remove_dir_all(&dir);
-    let child = Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
-        .arg(&dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let log = dir.join("plan_paper_planar.mcap");
-    let t0 = std::time::Instant::now();
-    while std::fs::metadata(&log).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let (child, log) = plan_until_first_chunks("interrupted");
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
