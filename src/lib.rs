@@ -20,6 +20,7 @@ pub mod constraints;
 pub mod energy;
 pub mod error;
 pub mod grasp;
+pub mod hessian;
 pub mod kinematics;
 pub mod layout;
 pub mod mcap_log;

@@ -111,4 +111,37 @@ impl DeformationPath {
             }
         }
     }
+
+    /// Adds `scale · ∂a/∂zᵀ · H · ∂a/∂z` at `k` to `h_z` (row-major `n_vars²`), for a row-major
+    /// `n×n` matrix `h_a` in coefficient space.
+    pub fn add_chain_hessian(&self, h_a: &[f64], k: f64, scale: f64, h_z: &mut [f64]) {
+        let n = self.n();
+        let r = self.basis.len();
+        let nv = self.n_vars();
+        // M = Nᵀ H N.
+        let mut hn = vec![0.0; n * r];
+        for (q, col) in self.basis.iter().enumerate() {
+            for a in 0..n {
+                hn[a * r + q] = crate::basis::dot(&h_a[a * n..(a + 1) * n], col);
+            }
+        }
+        let mut m = vec![0.0; r * r];
+        for (p, col) in self.basis.iter().enumerate() {
+            for q in 0..r {
+                m[p * r + q] = (0..n).map(|a| col[a] * hn[a * r + q]).sum();
+            }
+        }
+        for i in 0..self.terms {
+            let wi = scale * Self::weight(i + 1, k);
+            for i2 in 0..self.terms {
+                let w = wi * Self::weight(i2 + 1, k);
+                for p in 0..r {
+                    let row = &mut h_z[(i * r + p) * nv + i2 * r..(i * r + p) * nv + i2 * r + r];
+                    for (hv, mv) in row.iter_mut().zip(&m[p * r..(p + 1) * r]) {
+                        *hv += w * mv;
+                    }
+                }
+            }
+        }
+    }
 }

@@ -103,4 +103,47 @@ impl Nlp for StaticProblem {
         }
         self.adj.finish(&self.model, &self.shape, g);
     }
+    /// The energy's exact Hessian, the constraints' curvature through the positions, and the
+    /// Gauss–Newton part of the penalty; the curvature of the self-contact distance itself is left
+    /// out.
+    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
+        let n = self.model.n();
+        self.model
+            .add_energy_hessian(&self.shape, self.objective, 1.0, h);
+        self.adj.clear();
+        for (k, con) in self.constraints.iter().enumerate() {
+            let w = &y[self.offsets[k]..self.offsets[k + 1]];
+            if w.iter().any(|v| *v != 0.0) {
+                con.add_gradient(&self.model, x, &self.shape, w, &mut self.adj);
+                con.add_curvature(&self.model, x, &self.shape, w, h);
+            }
+        }
+        self.adj.finish_hessian(&self.model, &self.shape, h);
+        let mut unit = Vec::new();
+        let mut gi = vec![0.0; n];
+        for (k, con) in self.constraints.iter().enumerate() {
+            let rows = self.offsets[k]..self.offsets[k + 1];
+            for (r, i) in rows.clone().enumerate() {
+                if s[i] == 0.0 {
+                    continue;
+                }
+                unit.clear();
+                unit.resize(rows.len(), 0.0);
+                unit[r] = 1.0;
+                self.adj.clear();
+                con.add_gradient(&self.model, x, &self.shape, &unit, &mut self.adj);
+                gi.iter_mut().for_each(|v| *v = 0.0);
+                self.adj.finish(&self.model, &self.shape, &mut gi);
+                for a in 0..n {
+                    let w = s[i] * gi[a];
+                    if w != 0.0 {
+                        for (hv, gb) in h[a * n..(a + 1) * n].iter_mut().zip(&gi) {
+                            *hv += w * gb;
+                        }
+                    }
+                }
+            }
+        }
+        true
+    }
 }

@@ -135,3 +135,94 @@ fn verification_finds_a_rod_crossing_itself() {
         assert_eq!(v.collision_free(1e-9), !crosses);
     }
 }
+
+/// The Hessian of `f + Σ yᵢcᵢ` against central differences of the analytic gradient, and its
+/// penalty part `Σ sᵢ∇cᵢ∇cᵢᵀ` against gradient-differenced constraint rows. The curvature of
+/// the distance functions themselves is left out of the Hessian by design, so row weights on
+/// curved obstacles are zero (`curved_rows`).
+fn check_hessian(name: &str, tracking: bool, curved_rows: bool) {
+    let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
+    let pl = Planner::from_case(&c).unwrap();
+    let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
+    let mut p = pl.minimax_problem_at(ks.clone());
+    p.beta = 3.0;
+    p.mean_weight = 0.7;
+    let n = p.n();
+    let m = p.m();
+    let z: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 1.7).sin()).collect();
+    if tracking {
+        let z2: Vec<f64> = (0..n).map(|i| 0.04 * ((i as f64) * 0.9).cos()).collect();
+        let mut c = vec![0.0; m];
+        p.values(&z2, &mut c);
+        let targets: Vec<Vec<[f64; 3]>> = p
+            .sampled()
+            .iter()
+            .map(|a| p.model.evaluate(a).positions)
+            .collect();
+        p.targets = Some(targets);
+        p.track_weight = 50.0;
+    }
+    let y: Vec<f64> = (0..m)
+        .map(|i| {
+            if curved_rows {
+                0.0
+            } else {
+                0.3 * ((i as f64) * 0.37).cos()
+            }
+        })
+        .collect();
+    let mut c = vec![0.0; m];
+    p.values(&z, &mut c);
+    let mut h = vec![0.0; n * n];
+    assert!(p.hessian(&z, &y, &vec![0.0; m], &mut h));
+    let step = 1e-6;
+    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+    let scale = h.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        let mut zp = z.clone();
+        zp[j] += step;
+        p.values(&zp, &mut c);
+        p.gradient(&zp, &y, &mut gp);
+        zp[j] -= 2.0 * step;
+        p.values(&zp, &mut c);
+        p.gradient(&zp, &y, &mut gm);
+        for i in 0..n {
+            let fd = (gp[i] - gm[i]) / (2.0 * step);
+            worst = worst.max((fd - h[i * n + j]).abs() / scale);
+        }
+    }
+    assert!(worst < 1e-5, "{name}: Hessian relative error {worst:e}");
+    // Penalty part: two rows with weights s.
+    let mut s = vec![0.0; m];
+    let rows = [m / 3, m / 2];
+    for &r in &rows {
+        s[r] = 2.0 + r as f64;
+    }
+    p.values(&z, &mut c);
+    let mut h2 = vec![0.0; n * n];
+    p.hessian(&z, &y, &s, &mut h2);
+    let (_, jr) = dlo_planner::optim::augmented_lagrangian::jacobian_rows(&mut p, &z, &rows);
+    let scale2 = h2.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
+    let mut worst2: f64 = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let expect: f64 = rows.iter().zip(&jr).map(|(&r, g)| s[r] * g[i] * g[j]).sum();
+            worst2 = worst2.max((h2[i * n + j] - h[i * n + j] - expect).abs() / scale2);
+        }
+    }
+    assert!(
+        worst2 < 1e-9,
+        "{name}: penalty part relative error {worst2:e}"
+    );
+}
+
+#[test]
+fn planar_minimax_hessian_matches_finite_differences() {
+    check_hessian("plan_paper_planar.json", true, false);
+}
+
+#[test]
+fn spatial_minimax_hessian_matches_finite_differences() {
+    check_hessian("plan_cable_around_pillar.json", true, false);
+}

@@ -60,6 +60,12 @@ impl Adjoint {
         }
         model.add_positions_vjp(shape, &self.pos, grad);
     }
+
+    /// Adds the curvature of the accumulated position terms, `Σ_b pos[b] · ∂²x(b)/∂a²`, to the
+    /// row-major `n×n` matrix `h` (the `coef` part is linear and has none).
+    pub fn finish_hessian(&self, model: &Model, shape: &Shape, h: &mut [f64]) {
+        model.add_positions_hessian(shape, &self.pos, h);
+    }
 }
 
 /// A block of constraint rows.
@@ -74,6 +80,13 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn values(&self, model: &Model, a: &[f64], shape: &Shape, out: &mut [f64]);
     /// Adds `Σᵢ wᵢ ∇cᵢ` to `adj` (rows with `wᵢ = 0` may be skipped).
     fn add_gradient(&self, model: &Model, a: &[f64], shape: &Shape, w: &[f64], adj: &mut Adjoint);
+    /// Adds `Σᵢ wᵢ Jᵀ (∂²gᵢ/∂x²) J` to the row-major `n×n` matrix `h`, where a row is
+    /// `gᵢ(x)` of positions `x` with Jacobian `J`: the part of `∇²cᵢ` that
+    /// [`Adjoint::finish_hessian`] (the positions' own curvature) does not hold. Rows linear in
+    /// the positions have none (the default).
+    fn add_curvature(&self, model: &Model, a: &[f64], shape: &Shape, w: &[f64], h: &mut [f64]) {
+        let _ = (model, a, shape, w, h);
+    }
     /// Clones into a box.
     fn boxed_clone(&self) -> Box<dyn Constraint>;
     /// For reports that treat some kinds specially.

@@ -50,6 +50,49 @@ impl Constraint for ObstacleConstraint {
             adj.add_pos(b, -wi, n);
         }
     }
+    /// The distance function's Hessian by central differences of its normal (step `1e-6 L`).
+    fn add_curvature(&self, m: &Model, _a: &[f64], shape: &Shape, w: &[f64], h: &mut [f64]) {
+        let n = m.n();
+        let step = 1e-6 * self.length;
+        for (&wi, &b) in w.iter().zip(&self.samples) {
+            if wi == 0.0 {
+                continue;
+            }
+            let x = shape.positions[b].map(|v| v * self.length);
+            // D = ∂n/∂X (world units); ∇²ₓc = −L D for dimensionless x.
+            let mut d = [[0.0; 3]; 3];
+            for k in 0..3 {
+                let (mut xp, mut xm) = (x, x);
+                xp[k] += step;
+                xm[k] -= step;
+                let (_, np) = self.obstacle.signed_distance(xp);
+                let (_, nm) = self.obstacle.signed_distance(xm);
+                for r in 0..3 {
+                    d[r][k] = (np[r] - nm[r]) / (2.0 * step);
+                }
+            }
+            if d.iter().all(|r| r.iter().all(|v| v.abs() < 1e-9)) {
+                continue;
+            }
+            let jac = m.position_jacobian(shape, b);
+            for r in 0..3 {
+                for k in 0..3 {
+                    let dk = -wi * self.length * 0.5 * (d[r][k] + d[k][r]);
+                    if dk == 0.0 {
+                        continue;
+                    }
+                    for i in 0..n {
+                        let v = dk * jac[r][i];
+                        if v != 0.0 {
+                            for (hv, jv) in h[i * n..(i + 1) * n].iter_mut().zip(&jac[k]) {
+                                *hv += v * jv;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
     fn boxed_clone(&self) -> Box<dyn Constraint> {
         Box::new(self.clone())
     }

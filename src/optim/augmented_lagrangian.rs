@@ -12,6 +12,7 @@
 //! estimate of the multipliers from `∇f = −Jᵀλ` on the active set polishes them.
 
 use super::bfgs::{BfgsOptions, BfgsStatus, bfgs};
+use super::newton::{NewtonOptions, newton};
 use super::nlp::{Nlp, Sense};
 use nalgebra::{DMatrix, DVector};
 
@@ -32,6 +33,11 @@ pub struct AlOptions {
     pub max_inner: usize,
     /// An inequality row counts as active when `c > −active_tol` or its multiplier is positive.
     pub active_tol: f64,
+    /// Minimise the augmented function by damped Newton steps when the problem provides a
+    /// Hessian ([`Nlp::hessian`]); BFGS otherwise.
+    pub second_order: bool,
+    /// Largest Newton step `‖Δx‖∞` (keeps continuation on its branch).
+    pub max_step: f64,
 }
 
 impl Default for AlOptions {
@@ -44,6 +50,8 @@ impl Default for AlOptions {
             max_outer: 40,
             max_inner: 400,
             active_tol: 1e-7,
+            second_order: true,
+            max_step: f64::INFINITY,
         }
     }
 }
@@ -112,6 +120,37 @@ pub struct OuterIterate<'a> {
     pub x: &'a [f64],
 }
 
+/// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier estimates
+/// `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows whose
+/// penalty is active (`ρ`, else 0), which make the Gauss–Newton part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
+fn augment(
+    f: f64,
+    c: &[f64],
+    lam: &[f64],
+    rho: f64,
+    senses: &[Sense],
+    y: &mut [f64],
+    s: &mut [f64],
+) -> f64 {
+    let mut phi = f;
+    for i in 0..c.len() {
+        match senses[i] {
+            Sense::Equal => {
+                phi += lam[i] * c[i] + 0.5 * rho * c[i] * c[i];
+                y[i] = lam[i] + rho * c[i];
+                s[i] = rho;
+            }
+            Sense::LessEq => {
+                let t = (lam[i] + rho * c[i]).max(0.0);
+                phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
+                y[i] = t;
+                s[i] = if t > 0.0 { rho } else { 0.0 };
+            }
+        }
+    }
+    phi
+}
+
 /// Solves `p` from `x` (updated in place), warm-starting the multipliers from `lambda0` if given.
 pub fn augmented_lagrangian<P: Nlp>(
     p: &mut P,
@@ -143,31 +182,58 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut outer = 0;
     let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
+    let mut sw = vec![0.0; m];
+    let mut xh = x.to_vec();
+    let use_newton = opts.second_order && {
+        let mut probe = vec![0.0; n * n];
+        p.values(x, &mut c);
+        p.hessian(x, &y, &sw, &mut probe)
+    };
     while outer < opts.max_outer {
         outer += 1;
-        let out = {
+        let out = if use_newton {
+            let lam = &lambda;
+            let senses = &senses;
+            // `eval` and `hess` share the problem and the buffers; they run one after the other.
+            let state = std::cell::RefCell::new((&mut *p, &mut c, &mut y, &mut sw, &mut xh));
+            newton(
+                |xv, g| {
+                    let mut st = state.borrow_mut();
+                    let (p, c, y, sw, xh) = &mut *st;
+                    let f = p.values(xv, c);
+                    let phi = augment(f, c, lam, rho, senses, y, sw);
+                    if let Some(g) = g {
+                        p.gradient(xv, y, g);
+                        xh.copy_from_slice(xv);
+                    }
+                    phi
+                },
+                |h| {
+                    let mut st = state.borrow_mut();
+                    let (p, c, y, sw, xh) = &mut *st;
+                    // The last values call may have been a rejected trial point.
+                    p.values(xh, c);
+                    augment(0.0, c, lam, rho, senses, y, sw);
+                    p.hessian(xh, y, sw, h);
+                },
+                x,
+                NewtonOptions {
+                    grad_tol: inner_tol,
+                    max_iter: opts.max_inner,
+                    max_step: opts.max_step,
+                },
+            )
+        } else {
             let lam = &lambda;
             let c = &mut c;
             let y = &mut y;
+            let sw = &mut sw;
             let p = &mut *p;
             let senses = &senses;
             bfgs(
                 |xv, g| {
                     let f = p.values(xv, c);
-                    let mut phi = f;
-                    for i in 0..m {
-                        match senses[i] {
-                            Sense::Equal => {
-                                phi += lam[i] * c[i] + 0.5 * rho * c[i] * c[i];
-                                y[i] = lam[i] + rho * c[i];
-                            }
-                            Sense::LessEq => {
-                                let t = (lam[i] + rho * c[i]).max(0.0);
-                                phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
-                                y[i] = t;
-                            }
-                        }
-                    }
+                    let phi = augment(f, c, lam, rho, senses, y, sw);
                     p.gradient(xv, y, g);
                     phi
                 },

@@ -4,6 +4,7 @@
 pub mod augmented_lagrangian;
 pub mod bfgs;
 pub mod line_search;
+pub mod newton;
 pub mod nlp;
 pub mod second_order;
 
@@ -12,4 +13,5 @@ pub use augmented_lagrangian::{
     augmented_lagrangian_observed,
 };
 pub use bfgs::{BfgsOptions, BfgsOutcome, BfgsStatus, bfgs};
+pub use newton::{NewtonOptions, newton};
 pub use nlp::{Nlp, Sense};

@@ -23,4 +23,11 @@ pub trait Nlp {
     /// Writes `∇f(x) + Σᵢ yᵢ ∇cᵢ(x)` into `g`, at the `x` of the last [`Nlp::values`] call.
     /// Rows with `yᵢ = 0` may be skipped.
     fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]);
+    /// Adds `∇²f + Σᵢ yᵢ ∇²cᵢ + Σᵢ sᵢ ∇cᵢ ∇cᵢᵀ` (row-major `n×n`) to `h` at the `x` of the last
+    /// [`Nlp::values`] call, and returns true; or returns false when the problem has no second
+    /// derivatives (the default). Curvature an implementation leaves out must be documented.
+    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
+        let _ = (x, y, s, h);
+        false
+    }
 }

@@ -50,6 +50,7 @@ pub struct MinimaxProblem {
     weights: Vec<f64>,
     adj: Adjoint,
     ga: Vec<f64>,
+    ha: Vec<f64>,
 }
 
 impl MinimaxProblem {
@@ -99,6 +100,7 @@ impl MinimaxProblem {
             weights: vec![0.0; nk],
             adj,
             ga: vec![0.0; n],
+            ha: vec![0.0; n * n],
         }
     }
 
@@ -241,5 +243,102 @@ impl Nlp for MinimaxProblem {
                 self.path.add_chain(&self.ga, k, g);
             }
         }
+    }
+    /// Exact Hessian of the smoothed maximum and the mean (through the energy Hessian of every
+    /// sample), the constraints' curvature through the positions, and Gauss–Newton parts for
+    /// the tracking term and the penalty; the curvature of the self-contact distance itself is left
+    /// out.
+    fn hessian(&mut self, z: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
+        let _ = z;
+        let n = self.path.n();
+        let nv = self.path.n_vars();
+        let per = self.rows_per_sample();
+        let nk = self.ks.len() as f64;
+        let tracked = self.targets.is_some() && self.track_weight > 0.0;
+        // Softmax part: β (Σ w g gᵀ − ḡ ḡᵀ) with g the z-gradients of the samples.
+        let mut gz = vec![vec![0.0; nv]; self.ks.len()];
+        let mut gbar = vec![0.0; nv];
+        let mut row = 0;
+        let mut unit = Vec::new();
+        let mut gi = vec![0.0; n];
+        for (j, &k) in self.ks.iter().enumerate() {
+            if !(k > 0.0 && k < 1.0) {
+                continue;
+            }
+            self.path.add_chain(&self.gu[j], k, &mut gz[j]);
+            for (b, v) in gbar.iter_mut().zip(&gz[j]) {
+                *b += self.weights[j] * v;
+            }
+            let ha = &mut self.ha;
+            ha.iter_mut().for_each(|v| *v = 0.0);
+            let wj = self.weights[j] + self.mean_weight / nk;
+            let (model, shape) = (&self.model, &self.shapes[j]);
+            model.add_energy_hessian(shape, self.objective, wj, ha);
+            let yj = &y[row..row + per];
+            self.adj.clear();
+            for (b, blk) in self.blocks.iter().enumerate() {
+                let w = &yj[self.offsets[b]..self.offsets[b + 1]];
+                if w.iter().any(|v| *v != 0.0) {
+                    blk.add_gradient(model, &self.a[j], shape, w, &mut self.adj);
+                    blk.add_curvature(model, &self.a[j], shape, w, ha);
+                }
+            }
+            if let (true, Some(t)) = (tracked, &self.targets) {
+                let tj = &t[j];
+                let wt = self.track_weight / tj.len() as f64;
+                for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
+                    self.adj
+                        .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                }
+                model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
+            }
+            self.adj.finish_hessian(model, shape, ha);
+            // Penalty: Σ s ∇c ∇cᵀ over this sample's rows.
+            let sj = &s[row..row + per];
+            for (b, blk) in self.blocks.iter().enumerate() {
+                let range = self.offsets[b]..self.offsets[b + 1];
+                for (r, i) in range.clone().enumerate() {
+                    if sj[i] == 0.0 {
+                        continue;
+                    }
+                    unit.clear();
+                    unit.resize(range.len(), 0.0);
+                    unit[r] = 1.0;
+                    self.adj.clear();
+                    blk.add_gradient(model, &self.a[j], shape, &unit, &mut self.adj);
+                    gi.iter_mut().for_each(|v| *v = 0.0);
+                    self.adj.finish(model, shape, &mut gi);
+                    for a in 0..n {
+                        let w = sj[i] * gi[a];
+                        if w != 0.0 {
+                            for (hv, gb) in ha[a * n..(a + 1) * n].iter_mut().zip(&gi) {
+                                *hv += w * gb;
+                            }
+                        }
+                    }
+                }
+            }
+            self.path.add_chain_hessian(ha, k, 1.0, h);
+            row += per;
+        }
+        for (j, g) in gz.iter().enumerate() {
+            let w = self.beta * self.weights[j];
+            if w == 0.0 {
+                continue;
+            }
+            for a in 0..nv {
+                let wa = w * g[a];
+                for (hv, gb) in h[a * nv..(a + 1) * nv].iter_mut().zip(g) {
+                    *hv += wa * gb;
+                }
+            }
+        }
+        for a in 0..nv {
+            let wa = self.beta * gbar[a];
+            for (hv, gb) in h[a * nv..(a + 1) * nv].iter_mut().zip(&gbar) {
+                *hv -= wa * gb;
+            }
+        }
+        true
     }
 }

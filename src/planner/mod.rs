@@ -281,6 +281,10 @@ impl Planner {
         // tighter than 1e-5 (replayed shapes are compared at the 1e-3 L level).
         let mut static_options = case.options;
         static_options.al.optimality_tol = static_options.al.optimality_tol.max(1e-5);
+        // Newton steps of at most 0.1 per coefficient: replay and tracking solves continue from
+        // the previous shape and must stay on its branch of equilibria (unlimited steps let a
+        // solve jump to another equilibrium on the mesh case).
+        static_options.al.max_step = static_options.al.max_step.min(0.1);
         let start = end_shape(case, "start", &options.start, &static_options)?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
@@ -352,7 +356,6 @@ impl Planner {
             .copied()
             .fold(0.0_f64, f64::max)
             .max(1e-3);
-        let mut z = z0;
         let mut lambda: Option<Vec<f64>> = None;
         let mut status = AlStatus::IterationLimit;
         let mut violation = f64::INFINITY;
@@ -366,7 +369,10 @@ impl Planner {
             max_outer: 30,
             max_inner: 300,
             active_tol: 1e-7,
+            second_order: self.options.optimiser == spec::Optimiser::Newton,
+            max_step: f64::INFINITY,
         };
+        let mut z = z0;
         for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
             let out = {

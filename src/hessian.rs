@@ -1,0 +1,392 @@
+//! Second derivatives in coefficient space: the Hessian of the energy of eq. (7)–(13) and the
+//! curvature `Σ_b v_b · ∂²x(b)/∂a²` of positions contracted with one vector per mesh boundary.
+//!
+//! Every term of the energy is a function of six local quantities at a quadrature node,
+//! `u = (θ, θ', φ, φ', ψ', ε)`, each linear in the coefficients through the basis values `e(t)`
+//! or derivatives `e'(t)`; a position is a cumulative sum of tangents `(1+ε)(sθcφ, sθsφ, cθ)`.
+//! The Hessian is therefore `Σ_q Bqᵀ Hq Bq` with a 6×6 local `Hq` per node, assembled here.
+//! Together with [`crate::constraints::Adjoint`] this gives the Hessian of a Lagrangian up to
+//! the curvature of the obstacle distance functions themselves (treated as locally flat).
+
+use crate::energy::Objective;
+use crate::kinematics::Shape;
+use crate::layout::Field;
+use crate::model::Model;
+
+/// Local quantities at a node.
+const TH: usize = 0;
+const DTH: usize = 1;
+const PH: usize = 2;
+const DPH: usize = 3;
+const DPS: usize = 4;
+const EPS: usize = 5;
+
+/// Where each local quantity comes from: `(offset of the field, derivative?)`.
+fn sources(model: &Model) -> [Option<(usize, bool)>; 6] {
+    let lay = &model.layout;
+    let op = lay.offset(Field::Phi);
+    let ops = lay.offset(Field::Psi);
+    let oe = lay.offset(Field::Eps);
+    [
+        Some((0, false)),
+        Some((0, true)),
+        op.map(|o| (o, false)),
+        op.map(|o| (o, true)),
+        ops.map(|o| (o, true)),
+        oe.map(|o| (o, false)),
+    ]
+}
+
+impl Model {
+    /// Adds `Σ_q Bqᵀ Hq Bq` to the row-major `n×n` matrix `h`, where `local(q, hq)` fills the
+    /// upper triangle of node `q`'s 6×6 local Hessian (entries of absent fields are ignored).
+    fn assemble_local(&self, h: &mut [f64], mut local: impl FnMut(usize, &mut [[f64; 6]; 6])) {
+        let n = self.n();
+        let nb = self.nb();
+        let src = sources(self);
+        let mut hq = [[0.0; 6]; 6];
+        for q in 0..self.nodes() {
+            hq.iter_mut().for_each(|r| *r = [0.0; 6]);
+            local(q, &mut hq);
+            let (e, de) = (self.e_at(q), self.de_at(q));
+            for al in 0..6 {
+                let Some((oa, da)) = src[al] else { continue };
+                let va = if da { de } else { e };
+                for be in al..6 {
+                    let w = hq[al][be];
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let Some((ob, db)) = src[be] else { continue };
+                    let vb = if db { de } else { e };
+                    for i in 0..nb {
+                        let wi = w * va[i];
+                        let row = &mut h[(oa + i) * n + ob..(oa + i) * n + ob + nb];
+                        for (r, v) in row.iter_mut().zip(vb) {
+                            *r += wi * v;
+                        }
+                    }
+                    if al != be {
+                        for i in 0..nb {
+                            let wi = w * vb[i];
+                            let row = &mut h[(ob + i) * n + oa..(ob + i) * n + oa + nb];
+                            for (r, v) in row.iter_mut().zip(va) {
+                                *r += wi * v;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds `scale · ∇²E` to `h` (row-major `n×n`), where `E` is the objective's energy
+    /// (dimensionless) of the evaluated `shape`. For [`Objective::Internal`] the work of point
+    /// loads is included (its curvature comes from the positions').
+    pub fn add_energy_hessian(
+        &self,
+        shape: &Shape,
+        objective: Objective,
+        scale: f64,
+        h: &mut [f64],
+    ) {
+        let spatial = self.layout.spatial;
+        self.assemble_local(h, |q, hq| {
+            let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+            let (dph, dps, _eps) = (shape.dph[q], shape.dps[q], shape.eps[q]);
+            let one = 1.0 + shape.eps[q];
+            let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
+            let omega = dph * ct + dps;
+            // Gravity: wg (1+ε) sθ cφ.
+            hq[TH][TH] = -wg * one * st * cp;
+            hq[TH][PH] = -wg * one * ct * sp;
+            hq[PH][PH] = -wg * one * st * cp;
+            hq[TH][EPS] = wg * ct * cp;
+            hq[PH][EPS] = -wg * st * sp;
+            // Flexure: ½ wf (θ'² + φ'² sθ²).
+            hq[DTH][DTH] = wf;
+            hq[EPS][EPS] = we;
+            if spatial {
+                let c2 = ct * ct - st * st;
+                hq[TH][TH] +=
+                    wf * dph * dph * c2 + wt * dph * dph * st * st - wt * omega * dph * ct;
+                hq[TH][DPH] = 2.0 * wf * dph * st * ct - wt * dph * st * ct - wt * omega * st;
+                hq[TH][DPS] = -wt * dph * st;
+                hq[DPH][DPH] = wf * st * st + wt * ct * ct;
+                hq[DPH][DPS] = wt * ct;
+                hq[DPS][DPS] = wt;
+            }
+            for r in hq.iter_mut() {
+                for v in r.iter_mut() {
+                    *v *= scale;
+                }
+            }
+        });
+        if objective == Objective::Internal && !self.loads.is_empty() {
+            let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
+            for (ld, &b) in self.loads.iter().zip(&self.load_boundary) {
+                for k in 0..3 {
+                    v[b][k] -= scale * ld.force[k];
+                }
+            }
+            self.add_positions_hessian(shape, &v, h);
+        }
+    }
+
+    /// Adds `Σ_b v[b] · ∂²x(b)/∂a²` to `h` (row-major `n×n`), one vector per mesh boundary.
+    pub fn add_positions_hessian(&self, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) {
+        // Suffix sums: a node of panel j enters every position after it.
+        let panels = self.mesh.panels();
+        let mut suffix = vec![[0.0; 3]; panels];
+        let mut acc = [0.0; 3];
+        for j in (0..panels).rev() {
+            for k in 0..3 {
+                acc[k] += v[j + 1][k];
+            }
+            suffix[j] = acc;
+        }
+        if suffix.iter().all(|s| *s == [0.0; 3]) {
+            return;
+        }
+        let ps = &self.mesh.panel_start;
+        let mut panel_of = vec![0; self.nodes()];
+        for j in 0..panels {
+            for p in &mut panel_of[ps[j]..ps[j + 1]] {
+                *p = j;
+            }
+        }
+        self.assemble_local(h, |q, hq| {
+            let s = suffix[panel_of[q]];
+            if s == [0.0; 3] {
+                return;
+            }
+            let w = self.mesh.weights[q];
+            let one = 1.0 + shape.eps[q];
+            let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+            // S · t = (1+ε) (S₀ sθcφ + S₁ sθsφ + S₂ cθ).
+            let f = s[0] * st * cp + s[1] * st * sp + s[2] * ct;
+            let f_th = s[0] * ct * cp + s[1] * ct * sp - s[2] * st;
+            let f_ph = -s[0] * st * sp + s[1] * st * cp;
+            hq[TH][TH] = -w * one * f;
+            hq[TH][PH] = w * one * (-s[0] * ct * sp + s[1] * ct * cp);
+            hq[PH][PH] = -w * one * (s[0] * st * cp + s[1] * st * sp);
+            hq[TH][EPS] = w * f_th;
+            hq[PH][EPS] = w * f_ph;
+        });
+    }
+}
+
+impl Model {
+    /// Adds `Σ_b c[b] · J_bᵀ J_b` to `h` (row-major `n×n`), where `J_b = ∂x(b)/∂a` is the 3×n
+    /// Jacobian of the position at mesh boundary `b`: the Gauss–Newton Hessian of
+    /// `½ Σ_b c[b] |x(b) − x̄_b|²`.
+    pub fn add_positions_gauss_newton(&self, shape: &Shape, c: &[f64], h: &mut [f64]) {
+        let n = self.n();
+        let nb = self.nb();
+        let lay = &self.layout;
+        let op = lay.offset(Field::Phi);
+        let oe = lay.offset(Field::Eps);
+        let mut jac = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        if let Some(o) = lay.base_offset() {
+            for (k, &comp) in lay.components().iter().enumerate() {
+                jac[comp][o + k] = 1.0;
+            }
+        }
+        let ps = &self.mesh.panel_start;
+        let add = |jac: &[Vec<f64>; 3], w: f64, h: &mut [f64]| {
+            if w == 0.0 {
+                return;
+            }
+            for row in jac {
+                for a in 0..n {
+                    let wa = w * row[a];
+                    if wa != 0.0 {
+                        for (hv, rb) in h[a * n..(a + 1) * n].iter_mut().zip(row) {
+                            *hv += wa * rb;
+                        }
+                    }
+                }
+            }
+        };
+        add(&jac, c[0], h);
+        for j in 0..self.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q];
+                let one = 1.0 + shape.eps[q];
+                let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+                let e = self.e_at(q);
+                let dth = [one * ct * cp, one * ct * sp, -one * st];
+                let dph = [-one * st * sp, one * st * cp, 0.0];
+                let dep = [st * cp, st * sp, ct];
+                for k in 0..3 {
+                    for i in 0..nb {
+                        jac[k][i] += w * dth[k] * e[i];
+                    }
+                    if let Some(op) = op {
+                        for i in 0..nb {
+                            jac[k][op + i] += w * dph[k] * e[i];
+                        }
+                    }
+                    if let Some(oe) = oe {
+                        for i in 0..nb {
+                            jac[k][oe + i] += w * dep[k] * e[i];
+                        }
+                    }
+                }
+            }
+            add(&jac, c[j + 1], h);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::basis::Basis;
+    use crate::energy::Objective;
+    use crate::layout::Layout;
+    use crate::model::{Discretisation, Model, PointLoad};
+    use crate::rod::{Profile, Rod};
+
+    fn model(spatial: bool, extensible: bool) -> Model {
+        let rod = Rod {
+            length: 1.3,
+            flexural: Profile::Linear {
+                start: 1.0,
+                end: 0.6,
+            },
+            torsional: spatial.then_some(Profile::Constant(0.7)),
+            extensional: extensible.then_some(Profile::Constant(40.0)),
+            weight: Profile::Constant(0.8),
+            radius: 0.01,
+        };
+        let layout = Layout {
+            basis: Basis::new(2),
+            spatial,
+            extensible,
+            free_base: false,
+        };
+        let loads = vec![PointLoad {
+            t: 0.6,
+            force: [0.3, -0.2, 0.5],
+            reference: [0.0; 3],
+        }];
+        Model::new(
+            rod,
+            layout,
+            Discretisation {
+                panels: 6,
+                gauss_points: 3,
+            },
+            [0.0; 3],
+            loads,
+            &[],
+        )
+    }
+
+    fn coefficients(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| 0.3 * ((i as f64) * 1.7).sin() + 0.1)
+            .collect()
+    }
+
+    /// Central differences of the analytic gradient.
+    fn fd_hessian(n: usize, mut grad: impl FnMut(&[f64], &mut [f64]), a: &[f64]) -> Vec<f64> {
+        let step = 1e-6;
+        let mut h = vec![0.0; n * n];
+        let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+        let mut x = a.to_vec();
+        for j in 0..n {
+            x[j] = a[j] + step;
+            grad(&x, &mut gp);
+            x[j] = a[j] - step;
+            grad(&x, &mut gm);
+            x[j] = a[j];
+            for i in 0..n {
+                h[i * n + j] = (gp[i] - gm[i]) / (2.0 * step);
+            }
+        }
+        h
+    }
+
+    fn assert_close(h: &[f64], fd: &[f64]) {
+        let scale = fd.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        for (i, (x, y)) in h.iter().zip(fd).enumerate() {
+            assert!((x - y).abs() < 1e-6 * scale, "entry {i}: {x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn energy_hessian_matches_finite_differences() {
+        for (spatial, extensible) in [(false, false), (false, true), (true, false), (true, true)] {
+            let m = model(spatial, extensible);
+            let n = m.n();
+            let a = coefficients(n);
+            for objective in [Objective::Internal, Objective::Potential] {
+                let mut sh = m.evaluate(&a);
+                let mut h = vec![0.0; n * n];
+                m.add_energy_hessian(&sh, objective, 1.0, &mut h);
+                let fd = fd_hessian(
+                    n,
+                    |x, g| {
+                        m.objective_and_gradient(x, objective, &mut sh, g);
+                    },
+                    &a,
+                );
+                assert_close(&h, &fd);
+            }
+        }
+    }
+
+    #[test]
+    fn position_curvature_matches_finite_differences() {
+        for (spatial, extensible) in [(false, true), (true, false), (true, true)] {
+            let m = model(spatial, extensible);
+            let n = m.n();
+            let a = coefficients(n);
+            let nb = m.mesh.boundaries.len();
+            let v: Vec<[f64; 3]> = (0..nb)
+                .map(|b| {
+                    let t = b as f64;
+                    [(0.9 * t).sin(), (1.3 * t).cos(), 0.4 - 0.1 * t]
+                })
+                .collect();
+            let sh = m.evaluate(&a);
+            let mut h = vec![0.0; n * n];
+            m.add_positions_hessian(&sh, &v, &mut h);
+            let fd = fd_hessian(
+                n,
+                |x, g| {
+                    g.iter_mut().for_each(|v| *v = 0.0);
+                    m.add_positions_vjp(&m.evaluate(x), &v, g);
+                },
+                &a,
+            );
+            assert_close(&h, &fd);
+        }
+    }
+
+    #[test]
+    fn positions_gauss_newton_matches_jacobians() {
+        for (spatial, extensible) in [(false, true), (true, true)] {
+            let m = model(spatial, extensible);
+            let n = m.n();
+            let sh = m.evaluate(&coefficients(n));
+            let nbd = m.mesh.boundaries.len();
+            let c: Vec<f64> = (0..nbd).map(|b| 0.5 + 0.1 * b as f64).collect();
+            let mut h = vec![0.0; n * n];
+            m.add_positions_gauss_newton(&sh, &c, &mut h);
+            let mut expect = vec![0.0; n * n];
+            for (b, &cb) in c.iter().enumerate() {
+                let jb = m.position_jacobian(&sh, b);
+                for row in &jb {
+                    for i in 0..n {
+                        for j in 0..n {
+                            expect[i * n + j] += cb * row[i] * row[j];
+                        }
+                    }
+                }
+            }
+            assert_close(&h, &expect);
+        }
+    }
+}
