@@ -453,11 +453,17 @@ impl Planner {
                 if moved < 1e-4 {
                     break;
                 }
+                // Newton steps here in either mode: the sharpness stages have chosen the route,
+                // and tracking only pulls its shapes onto their equilibria.
+                let al_t = AlOptions {
+                    second_order: true,
+                    ..al
+                };
                 let out = augmented_lagrangian_observed(
                     &mut p,
                     &mut z,
                     lambda.as_deref(),
-                    al,
+                    al_t,
                     &mut |_| {},
                 );
                 evaluations += out.evaluations;

@@ -67,15 +67,16 @@ pub struct PlanSpec {
     pub optimiser: Optimiser,
 }
 
-/// Inner minimiser of the path optimisation (see the README for what each finds).
+/// Inner minimiser of the path optimisation's sharpness stages (see the README for what each
+/// finds); the equilibrium-tracking rounds always take Newton steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Optimiser {
     /// BFGS on the augmented function (the default).
     #[default]
     Bfgs,
-    /// Damped Newton with the analytic Hessian: about 5–15 times fewer seconds, but it settles
-    /// in other local minima, whose shapes lie farther from the equilibria.
+    /// Damped Newton with the analytic Hessian: several times faster, but it settles in other
+    /// local minima, whose shapes lie farther from the equilibria.
     Newton,
 }
 
