@@ -41,6 +41,7 @@ pub fn newton(
     let mut xn = vec![0.0; n];
     let mut shift = 0.0_f64;
     let mut iterations = 0;
+    let mut stalled = 0;
     let status =
         'outer: {
             if !f.is_finite() || g.iter().any(|v| !v.is_finite()) {
@@ -124,10 +125,15 @@ pub fn newton(
                 if slope >= 0.0 {
                     break 'outer BfgsStatus::LineSearchFailed;
                 }
-                // Backtracking: full step first.
+                // Backtracking: full step first. Near a minimum the predicted decrease falls below
+                // what f can resolve; there a step that lowers the gradient norm is taken instead.
                 let mut alpha = 1.0;
                 let mut accepted = false;
-                for _ in 0..40 {
+                let g_norm = inf_norm(&g);
+                let mut gt = vec![0.0; n];
+                // Down to α ≈ 2e-4: a Newton direction that needs shorter steps is not worth
+                // following (the caller sees a failed line search, as at the precision floor).
+                for _ in 0..13 {
                     for i in 0..n {
                         xn[i] = x[i] + alpha * d[i];
                     }
@@ -136,6 +142,14 @@ pub fn newton(
                     if fv.is_finite() && fv <= f + 1e-4 * alpha * slope {
                         accepted = true;
                         break;
+                    }
+                    if fv.is_finite() && (fv - f).abs() <= 1e-12 * f.abs().max(1.0) {
+                        eval(&xn, Some(&mut gt));
+                        evals += 1;
+                        if inf_norm(&gt) < 0.5 * g_norm {
+                            accepted = true;
+                            break;
+                        }
                     }
                     alpha *= if fv.is_finite() { 0.5 } else { 0.1 };
                 }
@@ -147,10 +161,20 @@ pub fn newton(
                     shift = shift.max(1e-6 * dmax);
                 }
                 x.copy_from_slice(&xn);
+                let f_old = f;
                 f = eval(x, Some(&mut g));
                 evals += 1;
                 if !f.is_finite() {
                     break 'outer BfgsStatus::NumericalFailure;
+                }
+                // At the precision floor f no longer moves: three such steps in a row end it.
+                if (f_old - f).abs() <= 1e-14 * f.abs().max(1.0) {
+                    stalled += 1;
+                    if stalled >= 3 {
+                        break 'outer BfgsStatus::Stalled;
+                    }
+                } else {
+                    stalled = 0;
                 }
             }
             if inf_norm(&g) <= opts.grad_tol {
