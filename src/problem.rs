@@ -103,6 +103,15 @@ impl Nlp for StaticProblem {
         }
         self.adj.finish(&self.model, &self.shape, g);
     }
+    fn hessian_is_exact(&self, y: &[f64]) -> bool {
+        self.constraints.iter().enumerate().all(|(k, con)| {
+            !con.as_any()
+                .is::<crate::constraints::SelfContactConstraint>()
+                || y[self.offsets[k]..self.offsets[k + 1]]
+                    .iter()
+                    .all(|v| *v == 0.0)
+        })
+    }
     /// The energy's exact Hessian, the constraints' curvature through the positions, and the
     /// Gauss–Newton part of the penalty; the curvature of the self-contact distance itself is left
     /// out.

@@ -1,5 +1,6 @@
-//! Second-order check of a KKT point: the Hessian of the Lagrangian, by central differences of
-//! analytic gradients, reduced to the tangent space of the strongly active constraints.
+//! Second-order check of a KKT point: the Hessian of the Lagrangian (analytic where the problem
+//! says its Hessian is exact, else central differences of analytic gradients), reduced to the
+//! tangent space of the strongly active constraints.
 
 use super::augmented_lagrangian::jacobian_rows;
 use super::nlp::{Nlp, Sense};
@@ -16,20 +17,26 @@ pub fn reduced_hessian_eigenvalues<P: Nlp>(
 ) -> Vec<f64> {
     let (n, m) = (p.n(), p.m());
     let mut c = vec![0.0; m];
-    let step = 1e-5;
     let mut hess = DMatrix::<f64>::zeros(n, n);
-    let mut xp = x.to_vec();
-    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
-    for j in 0..n {
-        xp[j] = x[j] + step;
-        p.values(&xp, &mut c);
-        p.gradient(&xp, lambda, &mut gp);
-        xp[j] = x[j] - step;
-        p.values(&xp, &mut c);
-        p.gradient(&xp, lambda, &mut gm);
-        xp[j] = x[j];
-        for i in 0..n {
-            hess[(i, j)] = (gp[i] - gm[i]) / (2.0 * step);
+    let mut analytic = vec![0.0; n * n];
+    p.values(x, &mut c);
+    if p.hessian_is_exact(lambda) && p.hessian(x, lambda, &vec![0.0; m], &mut analytic) {
+        hess = DMatrix::from_row_slice(n, n, &analytic);
+    } else {
+        let step = 1e-5;
+        let mut xp = x.to_vec();
+        let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..n {
+            xp[j] = x[j] + step;
+            p.values(&xp, &mut c);
+            p.gradient(&xp, lambda, &mut gp);
+            xp[j] = x[j] - step;
+            p.values(&xp, &mut c);
+            p.gradient(&xp, lambda, &mut gm);
+            xp[j] = x[j];
+            for i in 0..n {
+                hess[(i, j)] = (gp[i] - gm[i]) / (2.0 * step);
+            }
         }
     }
     let hess = 0.5 * (&hess + hess.transpose());
