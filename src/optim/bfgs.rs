@@ -113,6 +113,9 @@ pub fn bfgs(
                 d0 = d.iter().zip(&g).map(|(a, b)| a * b).sum();
                 first = true;
             }
+            // The last trial's point, value and gradient (xn, gn): reused when it is the
+            // accepted step, which is the usual case.
+            let mut last: Option<(f64, f64)> = None;
             let step = strong_wolfe(
                 |alpha| {
                     for i in 0..n {
@@ -120,6 +123,7 @@ pub fn bfgs(
                     }
                     let fv = fg(&xn, &mut gn);
                     evals += 1;
+                    last = Some((alpha, fv));
                     let dv = gn.iter().zip(&d).map(|(a, b)| a * b).sum();
                     (fv, dv)
                 },
@@ -131,12 +135,17 @@ pub fn bfgs(
             if step.alpha == 0.0 {
                 break 'outer BfgsStatus::LineSearchFailed;
             }
-            // Re-evaluate at the accepted step if the last trial was elsewhere.
-            for i in 0..n {
-                xn[i] = x[i] + step.alpha * d[i];
-            }
-            let fnew = fg(&xn, &mut gn);
-            evals += 1;
+            let fnew = match last {
+                Some((alpha, fv)) if alpha == step.alpha => fv,
+                _ => {
+                    // The accepted step was an earlier trial: evaluate it again.
+                    for i in 0..n {
+                        xn[i] = x[i] + step.alpha * d[i];
+                    }
+                    evals += 1;
+                    fg(&xn, &mut gn)
+                }
+            };
             for i in 0..n {
                 s[i] = xn[i] - x[i];
                 y[i] = gn[i] - g[i];
