@@ -5,20 +5,21 @@
 use dlo_planner::case;
 use dlo_planner::optim::Nlp;
 use dlo_planner::planner::Planner;
+use dlo_planner::planner::minimax::MinimaxProblem;
 use std::path::Path;
 
-fn check(name: &str, tracking: bool) {
+/// The planning problem of case `name` on 9 samples with test weights, a point `z` off the
+/// straight path, and (with `tracking`) targets: the sampled shapes of another path.
+fn setup(name: &str, tracking: bool) -> (MinimaxProblem, Vec<f64>) {
     let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
     let pl = Planner::from_case(&c).unwrap();
     let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
-    let mut p = pl.minimax_problem_at(ks.clone());
+    let mut p = pl.minimax_problem_at(ks);
     p.beta = 3.0;
     p.mean_weight = 0.7;
-    let n = p.n();
-    let m = p.m();
+    let (n, m) = (p.n(), p.m());
     let z: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 1.7).sin()).collect();
     if tracking {
-        // Targets: the sampled shapes of another path.
         let z2: Vec<f64> = (0..n).map(|i| 0.04 * ((i as f64) * 0.9).cos()).collect();
         let mut c = vec![0.0; m];
         p.values(&z2, &mut c);
@@ -30,9 +31,15 @@ fn check(name: &str, tracking: bool) {
         p.targets = Some(targets);
         p.track_weight = 50.0;
     }
+    (p, z)
+}
+
+fn check(name: &str, tracking: bool) {
+    let (mut p, z) = setup(name, tracking);
+    let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
     let mut c = vec![0.0; m];
-    let phi = |p: &mut dlo_planner::planner::minimax::MinimaxProblem, x: &[f64]| {
+    let phi = |p: &mut MinimaxProblem, x: &[f64]| {
         let mut c = vec![0.0; m];
         let f = p.values(x, &mut c);
         f + y.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>()
@@ -136,41 +143,13 @@ fn verification_finds_a_rod_crossing_itself() {
     }
 }
 
-/// The Hessian of `f + Σ yᵢcᵢ` against central differences of the analytic gradient, and its
-/// penalty part `Σ sᵢ∇cᵢ∇cᵢᵀ` against gradient-differenced constraint rows. The curvature of
-/// the distance functions themselves is left out of the Hessian by design, so row weights on
-/// curved obstacles are zero (`curved_rows`).
-fn check_hessian(name: &str, tracking: bool, curved_rows: bool) {
-    let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
-    let pl = Planner::from_case(&c).unwrap();
-    let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
-    let mut p = pl.minimax_problem_at(ks.clone());
-    p.beta = 3.0;
-    p.mean_weight = 0.7;
-    let n = p.n();
-    let m = p.m();
-    let z: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 1.7).sin()).collect();
-    if tracking {
-        let z2: Vec<f64> = (0..n).map(|i| 0.04 * ((i as f64) * 0.9).cos()).collect();
-        let mut c = vec![0.0; m];
-        p.values(&z2, &mut c);
-        let targets: Vec<Vec<[f64; 3]>> = p
-            .sampled()
-            .iter()
-            .map(|a| p.model.evaluate(a).positions)
-            .collect();
-        p.targets = Some(targets);
-        p.track_weight = 50.0;
-    }
-    let y: Vec<f64> = (0..m)
-        .map(|i| {
-            if curved_rows {
-                0.0
-            } else {
-                0.3 * ((i as f64) * 0.37).cos()
-            }
-        })
-        .collect();
+/// The Hessian of `f + Σ yᵢcᵢ` against central differences of the analytic gradient (with the
+/// obstacle distance's own curvature), and its penalty part `Σ sᵢ∇cᵢ∇cᵢᵀ` against
+/// gradient-differenced constraint rows.
+fn check_hessian(name: &str, tracking: bool) {
+    let (mut p, z) = setup(name, tracking);
+    let (n, m) = (p.n(), p.m());
+    let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
     let mut c = vec![0.0; m];
     p.values(&z, &mut c);
     let mut h = vec![0.0; n * n];
@@ -219,10 +198,10 @@ fn check_hessian(name: &str, tracking: bool, curved_rows: bool) {
 
 #[test]
 fn planar_minimax_hessian_matches_finite_differences() {
-    check_hessian("plan_paper_planar.json", true, false);
+    check_hessian("plan_paper_planar.json", true);
 }
 
 #[test]
 fn spatial_minimax_hessian_matches_finite_differences() {
-    check_hessian("plan_cable_around_pillar.json", true, false);
+    check_hessian("plan_cable_around_pillar.json", true);
 }

@@ -54,7 +54,8 @@ pub struct BfgsOutcome {
     pub status: BfgsStatus,
 }
 
-fn inf_norm(v: &[f64]) -> f64 {
+/// `‖v‖∞`.
+pub(crate) fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 

@@ -6,7 +6,7 @@
 //! Marquardt shift), and is remembered, divided by 10, for the next step. Near a minimum with a
 //! positive definite Hessian the steps are pure Newton steps and converge quadratically.
 
-use super::bfgs::{BfgsOutcome, BfgsStatus};
+use super::bfgs::{BfgsOutcome, BfgsStatus, inf_norm};
 use nalgebra::{DMatrix, DVector};
 
 /// Options for [`newton`].
@@ -18,10 +18,6 @@ pub struct NewtonOptions {
     pub max_iter: usize,
     /// Largest step `‖d‖∞` (a longer Newton step is scaled back to it).
     pub max_step: f64,
-}
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// Minimises `f` from `x` (updated in place). `eval(x, g)` returns `f(x)` and, when `g` is given,
