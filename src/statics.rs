@@ -18,7 +18,8 @@ pub type SolveStatus = AlStatus;
 pub struct StaticOptions {
     /// Multiplier-method settings.
     pub al: AlOptions,
-    /// Whether to compute the stability verdict (costs `2n` gradient evaluations).
+    /// Whether to compute the stability verdict (one Hessian: analytic where exact, else `2n`
+    /// gradient evaluations).
     pub stability: bool,
     /// Relative tolerance on the reduced Hessian's smallest eigenvalue: the shape is called
     /// stable when `λ_min > −tol · max(1, |λ_max|)`.
