@@ -288,8 +288,9 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                 status = AlStatus::Infeasible;
                 break;
             }
+            // BFGS keeps its curvature: the penalty's share of it grows, and the updates
+            // follow (clearing it here cost the planner twice the evaluations).
             rho = (rho * 10.0).min(opts.rho_max);
-            h.clear();
         }
         viol_prev = viol;
         inner_tol = (inner_tol * 0.1).max(opts.optimality_tol);
