@@ -75,8 +75,8 @@ pub enum Optimiser {
     /// BFGS on the augmented function (the default).
     #[default]
     Bfgs,
-    /// Damped Newton with the analytic Hessian: several times faster, but it settles in other
-    /// local minima, whose shapes lie farther from the equilibria.
+    /// Damped Newton with the analytic Hessian: it settles in other local minima, whose shapes
+    /// lie farther from the equilibria.
     Newton,
 }
 
