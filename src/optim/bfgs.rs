@@ -39,6 +39,17 @@ pub enum BfgsStatus {
     NumericalFailure,
 }
 
+impl BfgsStatus {
+    /// The status of a minimiser whose iteration budget ran out at gradient `g`.
+    pub(crate) fn at_budget_end(g: &[f64], grad_tol: f64) -> BfgsStatus {
+        if inf_norm(g) <= grad_tol {
+            BfgsStatus::Converged
+        } else {
+            BfgsStatus::IterationLimit
+        }
+    }
+}
+
 /// Result of [`bfgs`].
 #[derive(Clone, Debug)]
 pub struct BfgsOutcome {
@@ -185,11 +196,7 @@ pub fn bfgs(
                 break 'outer BfgsStatus::Stalled;
             }
         }
-        if inf_norm(&g) <= opts.grad_tol {
-            BfgsStatus::Converged
-        } else {
-            BfgsStatus::IterationLimit
-        }
+        BfgsStatus::at_budget_end(&g, opts.grad_tol)
     };
     BfgsOutcome {
         f,

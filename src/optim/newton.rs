@@ -173,11 +173,7 @@ pub fn newton(
                     stalled = 0;
                 }
             }
-            if inf_norm(&g) <= opts.grad_tol {
-                BfgsStatus::Converged
-            } else {
-                BfgsStatus::IterationLimit
-            }
+            BfgsStatus::at_budget_end(&g, opts.grad_tol)
         };
     BfgsOutcome {
         f,
