@@ -198,14 +198,7 @@ impl Model {
                 return;
             }
             for row in jac {
-                for a in 0..n {
-                    let wa = w * row[a];
-                    if wa != 0.0 {
-                        for (hv, rb) in h[a * n..(a + 1) * n].iter_mut().zip(row) {
-                            *hv += wa * rb;
-                        }
-                    }
-                }
+                add_rank_one(h, w, row);
             }
         };
         add(&jac, c[0], h);
@@ -235,6 +228,20 @@ impl Model {
                 }
             }
             add(&jac, c[j + 1], h);
+        }
+    }
+}
+
+/// Adds `w · g gᵀ` to the row-major `n×n` matrix `h` (`n = g.len()`); rows where `w gₐ = 0`
+/// are skipped.
+pub fn add_rank_one(h: &mut [f64], w: f64, g: &[f64]) {
+    let n = g.len();
+    for (a, &ga) in g.iter().enumerate() {
+        let wa = w * ga;
+        if wa != 0.0 {
+            for (hv, gb) in h[a * n..(a + 1) * n].iter_mut().zip(g) {
+                *hv += wa * gb;
+            }
         }
     }
 }

@@ -1,7 +1,7 @@
 //! A static-shape problem as a nonlinear program: minimise the internal energy `V` of eq. (13)
 //! over the Ritz coefficients subject to the geometric constraints of §3.2.
 
-use crate::constraints::{Adjoint, Constraint};
+use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
 use crate::energy::{EnergyTerms, Objective};
 use crate::kinematics::Shape;
 use crate::model::Model;
@@ -103,6 +103,9 @@ impl Nlp for StaticProblem {
         }
         self.adj.finish(&self.model, &self.shape, g);
     }
+    fn has_hessian(&self) -> bool {
+        true
+    }
     fn hessian_is_exact(&self, y: &[f64]) -> bool {
         self.constraints.iter().enumerate().all(|(k, con)| {
             !con.as_any()
@@ -115,44 +118,12 @@ impl Nlp for StaticProblem {
     /// The energy's exact Hessian, the constraints' curvature through the positions, and the
     /// Gauss–Newton part of the penalty; the curvature of the self-contact distance itself is left
     /// out.
-    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
-        let n = self.model.n();
-        self.model
-            .add_energy_hessian(&self.shape, self.objective, 1.0, h);
-        self.adj.clear();
-        for (k, con) in self.constraints.iter().enumerate() {
-            let w = &y[self.offsets[k]..self.offsets[k + 1]];
-            if w.iter().any(|v| *v != 0.0) {
-                con.add_gradient(&self.model, x, &self.shape, w, &mut self.adj);
-                con.add_curvature(&self.model, x, &self.shape, w, h);
-            }
-        }
-        self.adj.finish_hessian(&self.model, &self.shape, h);
-        let mut unit = Vec::new();
-        let mut gi = vec![0.0; n];
-        for (k, con) in self.constraints.iter().enumerate() {
-            let rows = self.offsets[k]..self.offsets[k + 1];
-            for (r, i) in rows.clone().enumerate() {
-                if s[i] == 0.0 {
-                    continue;
-                }
-                unit.clear();
-                unit.resize(rows.len(), 0.0);
-                unit[r] = 1.0;
-                self.adj.clear();
-                con.add_gradient(&self.model, x, &self.shape, &unit, &mut self.adj);
-                gi.iter_mut().for_each(|v| *v = 0.0);
-                self.adj.finish(&self.model, &self.shape, &mut gi);
-                for a in 0..n {
-                    let w = s[i] * gi[a];
-                    if w != 0.0 {
-                        for (hv, gb) in h[a * n..(a + 1) * n].iter_mut().zip(&gi) {
-                            *hv += w * gb;
-                        }
-                    }
-                }
-            }
-        }
-        true
+    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
+        let (model, shape) = (&self.model, &self.shape);
+        model.add_energy_hessian(shape, self.objective, 1.0, h);
+        let (blocks, offsets) = (&self.constraints, &self.offsets);
+        add_weighted_curvature(blocks, offsets, model, x, shape, y, &mut self.adj, h);
+        self.adj.finish_hessian(model, shape, h);
+        add_penalty_gauss_newton(blocks, offsets, model, x, shape, s, &mut self.adj, h);
     }
 }

@@ -98,3 +98,61 @@ impl Clone for Box<dyn Constraint> {
         self.boxed_clone()
     }
 }
+
+/// For constraint `blocks` whose rows sit at `offsets` (`offsets[b]..offsets[b + 1]`) in `y`:
+/// collects the position cotangents of `Σ yᵢ∇cᵢ` in `adj` (cleared first) and adds the blocks'
+/// own curvature ([`Constraint::add_curvature`]) to `h`. The positions' curvature follows from
+/// [`Adjoint::finish_hessian`], once the caller has added any other position terms.
+#[allow(clippy::too_many_arguments)]
+pub fn add_weighted_curvature(
+    blocks: &[Box<dyn Constraint>],
+    offsets: &[usize],
+    model: &Model,
+    a: &[f64],
+    shape: &Shape,
+    y: &[f64],
+    adj: &mut Adjoint,
+    h: &mut [f64],
+) {
+    adj.clear();
+    for (b, blk) in blocks.iter().enumerate() {
+        let w = &y[offsets[b]..offsets[b + 1]];
+        if w.iter().any(|v| *v != 0.0) {
+            blk.add_gradient(model, a, shape, w, adj);
+            blk.add_curvature(model, a, shape, w, h);
+        }
+    }
+}
+
+/// Adds `Σ sᵢ ∇cᵢ∇cᵢᵀ` over the rows with `sᵢ ≠ 0` (the Gauss–Newton part of a penalty) to the
+/// row-major `n×n` matrix `h`; rows laid out as in [`add_weighted_curvature`], `adj` is scratch.
+#[allow(clippy::too_many_arguments)]
+pub fn add_penalty_gauss_newton(
+    blocks: &[Box<dyn Constraint>],
+    offsets: &[usize],
+    model: &Model,
+    a: &[f64],
+    shape: &Shape,
+    s: &[f64],
+    adj: &mut Adjoint,
+    h: &mut [f64],
+) {
+    let mut unit = Vec::new();
+    let mut gi = vec![0.0; model.n()];
+    for (b, blk) in blocks.iter().enumerate() {
+        let rows = offsets[b]..offsets[b + 1];
+        for (r, i) in rows.clone().enumerate() {
+            if s[i] == 0.0 {
+                continue;
+            }
+            unit.clear();
+            unit.resize(rows.len(), 0.0);
+            unit[r] = 1.0;
+            adj.clear();
+            blk.add_gradient(model, a, shape, &unit, adj);
+            gi.iter_mut().for_each(|v| *v = 0.0);
+            adj.finish(model, shape, &mut gi);
+            crate::hessian::add_rank_one(h, s[i], &gi);
+        }
+    }
+}

@@ -183,38 +183,31 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
     let mut sw = vec![0.0; m];
-    let mut xh = x.to_vec();
-    let use_newton = opts.second_order && {
-        let mut probe = vec![0.0; n * n];
-        p.values(x, &mut c);
-        p.hessian(x, &y, &sw, &mut probe)
-    };
+    let use_newton = opts.second_order && p.has_hessian();
     while outer < opts.max_outer {
         outer += 1;
         let out = if use_newton {
             let lam = &lambda;
             let senses = &senses;
-            // `eval` and `hess` share the problem and the buffers; they run one after the other.
-            let state = std::cell::RefCell::new((&mut *p, &mut c, &mut y, &mut sw, &mut xh));
+            // `eval` and `hess` share the problem and the buffers; they run one after the other,
+            // and `hess` comes right after an `eval` at its point (the problem's state, `y` and
+            // the penalty weights are that evaluation's).
+            let state = std::cell::RefCell::new((&mut *p, &mut c, &mut y, &mut sw));
             newton(
                 |xv, g| {
                     let mut st = state.borrow_mut();
-                    let (p, c, y, sw, xh) = &mut *st;
+                    let (p, c, y, sw) = &mut *st;
                     let f = p.values(xv, c);
                     let phi = augment(f, c, lam, rho, senses, y, sw);
                     if let Some(g) = g {
                         p.gradient(xv, y, g);
-                        xh.copy_from_slice(xv);
                     }
                     phi
                 },
-                |h| {
+                |xv, h| {
                     let mut st = state.borrow_mut();
-                    let (p, c, y, sw, xh) = &mut *st;
-                    // The last values call may have been a rejected trial point.
-                    p.values(xh, c);
-                    augment(0.0, c, lam, rho, senses, y, sw);
-                    p.hessian(xh, y, sw, h);
+                    let (p, _, y, sw) = &mut *st;
+                    p.hessian(xv, y, sw, h);
                 },
                 x,
                 NewtonOptions {

@@ -21,11 +21,12 @@ pub struct NewtonOptions {
 }
 
 /// Minimises `f` from `x` (updated in place). `eval(x, g)` returns `f(x)` and, when `g` is given,
-/// writes `∇f(x)`; `hess(h)` writes the (row-major `n×n`) Hessian at the point of the last
-/// `eval` call that asked for a gradient.
+/// writes `∇f(x)`; `hess(x, h)` writes the (row-major `n×n`) Hessian at `x`. Every `hess` call
+/// comes right after an `eval` at the same `x` that asked for a gradient, with no `eval` between,
+/// so a problem may reuse the state of that evaluation.
 pub fn newton(
     mut eval: impl FnMut(&[f64], Option<&mut [f64]>) -> f64,
-    mut hess: impl FnMut(&mut [f64]),
+    mut hess: impl FnMut(&[f64], &mut [f64]),
     x: &mut [f64],
     opts: NewtonOptions,
 ) -> BfgsOutcome {
@@ -35,6 +36,7 @@ pub fn newton(
     let mut evals = 1;
     let mut h = vec![0.0; n * n];
     let mut xn = vec![0.0; n];
+    let mut gt = vec![0.0; n];
     let mut shift = 0.0_f64;
     let mut iterations = 0;
     let mut stalled = 0;
@@ -45,7 +47,7 @@ pub fn newton(
             }
             for _ in 0..opts.max_iter {
                 h.iter_mut().for_each(|v| *v = 0.0);
-                hess(&mut h);
+                hess(x, &mut h);
                 if h.iter().any(|v| !v.is_finite()) {
                     break 'outer BfgsStatus::NumericalFailure;
                 }
@@ -124,9 +126,9 @@ pub fn newton(
                 // Backtracking: full step first. Near a minimum the predicted decrease falls below
                 // what f can resolve; there a step that lowers the gradient norm is taken instead.
                 let mut alpha = 1.0;
-                let mut accepted = false;
+                // Some(f at the step), plus whether its gradient is already in `gt`.
+                let mut accepted = None;
                 let g_norm = inf_norm(&g);
-                let mut gt = vec![0.0; n];
                 // Down to α ≈ 2e-4: a Newton direction that needs shorter steps is not worth
                 // following (the caller sees a failed line search, as at the precision floor).
                 for _ in 0..13 {
@@ -136,30 +138,35 @@ pub fn newton(
                     let fv = eval(&xn, None);
                     evals += 1;
                     if fv.is_finite() && fv <= f + 1e-4 * alpha * slope {
-                        accepted = true;
+                        accepted = Some((fv, false));
                         break;
                     }
                     if fv.is_finite() && (fv - f).abs() <= 1e-12 * f.abs().max(1.0) {
-                        eval(&xn, Some(&mut gt));
+                        let fg = eval(&xn, Some(&mut gt));
                         evals += 1;
                         if inf_norm(&gt) < 0.5 * g_norm {
-                            accepted = true;
+                            accepted = Some((fg, true));
                             break;
                         }
                     }
                     alpha *= if fv.is_finite() { 0.5 } else { 0.1 };
                 }
-                if !accepted {
+                let Some((f_step, have_gradient)) = accepted else {
                     break 'outer BfgsStatus::LineSearchFailed;
-                }
+                };
                 // A step that is not a full one hints at a poor model: shift more next time.
                 if alpha < 1.0 {
                     shift = shift.max(1e-6 * dmax);
                 }
                 x.copy_from_slice(&xn);
                 let f_old = f;
-                f = eval(x, Some(&mut g));
-                evals += 1;
+                if have_gradient {
+                    f = f_step;
+                    g.copy_from_slice(&gt);
+                } else {
+                    f = eval(x, Some(&mut g));
+                    evals += 1;
+                }
                 if !f.is_finite() {
                     break 'outer BfgsStatus::NumericalFailure;
                 }
@@ -199,16 +206,9 @@ mod tests {
             100.0 * a * a + b * b
         };
         let mut x = vec![-1.2, 1.0];
-        let at = std::cell::RefCell::new(x.clone());
         let out = newton(
-            |xv, g| {
-                if g.is_some() {
-                    at.borrow_mut().copy_from_slice(xv);
-                }
-                eval(xv, g)
-            },
-            |h| {
-                let x = at.borrow();
+            eval,
+            |x, h| {
                 h[0] = 1200.0 * x[0] * x[0] - 400.0 * x[1] + 2.0;
                 h[1] = -400.0 * x[0];
                 h[2] = -400.0 * x[0];

@@ -23,12 +23,15 @@ pub trait Nlp {
     /// Writes `∇f(x) + Σᵢ yᵢ ∇cᵢ(x)` into `g`, at the `x` of the last [`Nlp::values`] call.
     /// Rows with `yᵢ = 0` may be skipped.
     fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]);
-    /// Adds `∇²f + Σᵢ yᵢ ∇²cᵢ + Σᵢ sᵢ ∇cᵢ ∇cᵢᵀ` (row-major `n×n`) to `h` at the `x` of the last
-    /// [`Nlp::values`] call, and returns true; or returns false when the problem has no second
-    /// derivatives (the default). Curvature an implementation leaves out must be documented.
-    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
-        let _ = (x, y, s, h);
+    /// Whether the problem provides second derivatives ([`Nlp::hessian`]).
+    fn has_hessian(&self) -> bool {
         false
+    }
+    /// Adds `∇²f + Σᵢ yᵢ ∇²cᵢ + Σᵢ sᵢ ∇cᵢ ∇cᵢᵀ` (row-major `n×n`) to `h` at the `x` of the last
+    /// [`Nlp::values`] call, when [`Nlp::has_hessian`] says so (the default adds nothing).
+    /// Curvature an implementation leaves out must be documented.
+    fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
+        let _ = (x, y, s, h);
     }
     /// Whether [`Nlp::hessian`] with weights `y` (and `s = 0`) is the exact Hessian of the
     /// Lagrangian, so that second-order checks may use it instead of differences.

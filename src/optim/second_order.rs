@@ -20,7 +20,8 @@ pub fn reduced_hessian_eigenvalues<P: Nlp>(
     let mut hess = DMatrix::<f64>::zeros(n, n);
     let mut analytic = vec![0.0; n * n];
     p.values(x, &mut c);
-    if p.hessian_is_exact(lambda) && p.hessian(x, lambda, &vec![0.0; m], &mut analytic) {
+    if p.has_hessian() && p.hessian_is_exact(lambda) {
+        p.hessian(x, lambda, &vec![0.0; m], &mut analytic);
         hess = DMatrix::from_row_slice(n, n, &analytic);
     } else {
         let step = 1e-5;

@@ -12,8 +12,9 @@
 //! interior sample `k_j`: each block's rows are repeated per sample. Energies are dimensionless
 //! (`Rf/L`), positions in units of `L`.
 
-use crate::constraints::{Adjoint, Constraint};
+use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
 use crate::energy::Objective;
+use crate::hessian::add_rank_one;
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::{Nlp, Sense};
@@ -248,9 +249,11 @@ impl Nlp for MinimaxProblem {
     /// sample), the constraints' curvature through the positions, and Gauss–Newton parts for
     /// the tracking term and the penalty; the curvature of the self-contact distance itself is left
     /// out.
-    fn hessian(&mut self, z: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) -> bool {
+    fn has_hessian(&self) -> bool {
+        true
+    }
+    fn hessian(&mut self, z: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
         let _ = z;
-        let n = self.path.n();
         let nv = self.path.n_vars();
         let per = self.rows_per_sample();
         let nk = self.ks.len() as f64;
@@ -259,8 +262,6 @@ impl Nlp for MinimaxProblem {
         let mut gz = vec![vec![0.0; nv]; self.ks.len()];
         let mut gbar = vec![0.0; nv];
         let mut row = 0;
-        let mut unit = Vec::new();
-        let mut gi = vec![0.0; n];
         for (j, &k) in self.ks.iter().enumerate() {
             if !(k > 0.0 && k < 1.0) {
                 continue;
@@ -274,15 +275,9 @@ impl Nlp for MinimaxProblem {
             let wj = self.weights[j] + self.mean_weight / nk;
             let (model, shape) = (&self.model, &self.shapes[j]);
             model.add_energy_hessian(shape, self.objective, wj, ha);
+            let (blocks, offsets, aj) = (&self.blocks, &self.offsets, &self.a[j]);
             let yj = &y[row..row + per];
-            self.adj.clear();
-            for (b, blk) in self.blocks.iter().enumerate() {
-                let w = &yj[self.offsets[b]..self.offsets[b + 1]];
-                if w.iter().any(|v| *v != 0.0) {
-                    blk.add_gradient(model, &self.a[j], shape, w, &mut self.adj);
-                    blk.add_curvature(model, &self.a[j], shape, w, ha);
-                }
-            }
+            add_weighted_curvature(blocks, offsets, model, aj, shape, yj, &mut self.adj, ha);
             if let (true, Some(t)) = (tracked, &self.targets) {
                 let tj = &t[j];
                 let wt = self.track_weight / tj.len() as f64;
@@ -293,52 +288,14 @@ impl Nlp for MinimaxProblem {
                 model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
             }
             self.adj.finish_hessian(model, shape, ha);
-            // Penalty: Σ s ∇c ∇cᵀ over this sample's rows.
             let sj = &s[row..row + per];
-            for (b, blk) in self.blocks.iter().enumerate() {
-                let range = self.offsets[b]..self.offsets[b + 1];
-                for (r, i) in range.clone().enumerate() {
-                    if sj[i] == 0.0 {
-                        continue;
-                    }
-                    unit.clear();
-                    unit.resize(range.len(), 0.0);
-                    unit[r] = 1.0;
-                    self.adj.clear();
-                    blk.add_gradient(model, &self.a[j], shape, &unit, &mut self.adj);
-                    gi.iter_mut().for_each(|v| *v = 0.0);
-                    self.adj.finish(model, shape, &mut gi);
-                    for a in 0..n {
-                        let w = sj[i] * gi[a];
-                        if w != 0.0 {
-                            for (hv, gb) in ha[a * n..(a + 1) * n].iter_mut().zip(&gi) {
-                                *hv += w * gb;
-                            }
-                        }
-                    }
-                }
-            }
+            add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut self.adj, ha);
             self.path.add_chain_hessian(ha, k, 1.0, h);
             row += per;
         }
         for (j, g) in gz.iter().enumerate() {
-            let w = self.beta * self.weights[j];
-            if w == 0.0 {
-                continue;
-            }
-            for a in 0..nv {
-                let wa = w * g[a];
-                for (hv, gb) in h[a * nv..(a + 1) * nv].iter_mut().zip(g) {
-                    *hv += wa * gb;
-                }
-            }
+            add_rank_one(h, self.beta * self.weights[j], g);
         }
-        for a in 0..nv {
-            let wa = self.beta * gbar[a];
-            for (hv, gb) in h[a * nv..(a + 1) * nv].iter_mut().zip(&gbar) {
-                *hv -= wa * gb;
-            }
-        }
-        true
+        add_rank_one(h, -self.beta, &gbar);
     }
 }
