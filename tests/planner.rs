@@ -210,12 +210,17 @@ fn twin_shapes_need_the_end_pulled_straight() {
     };
     let untracked = run(r#", "equilibrium_weight": 0"#);
     assert!(!untracked.replay.coincide);
-    assert!(
-        untracked.replay.max_deviation_over_l > 0.05 || !untracked.replay.snaps.is_empty(),
-        "{} {:?}",
-        untracked.replay.max_deviation_over_l,
-        untracked.replay.snaps
-    );
+    // The departure lies in the swing (0.2 ≤ k ≤ 0.8), where the plan's shapes are no end
+    // pose's equilibria. Near k = 0.85 the strip is nearly straight, and which S the replay
+    // buckles into there is the solver's choice at a pitchfork; the swing's departure is not.
+    let swing = untracked
+        .replay
+        .steps
+        .iter()
+        .filter(|s| (0.2..=0.8).contains(&s.k))
+        .map(|s| s.deviation)
+        .fold(0.0, f64::max);
+    assert!(swing > untracked.replay.tolerance, "{swing}");
     let tracked = run("");
     assert!(
         tracked.replay.coincide,

@@ -38,6 +38,14 @@ pub struct AlOptions {
     pub second_order: bool,
     /// Largest Newton step `‖Δx‖∞` (keeps continuation on its branch).
     pub max_step: f64,
+    /// The penalty grows ×10 after an outer iteration that does not bring the violation below
+    /// this fraction of the previous one.
+    pub decrease: f64,
+    /// With Newton inner steps, update the multipliers of the active rows by a Newton step on
+    /// the dual function, `λ ← λ + (J ∇²Φ⁻¹ Jᵀ)⁻¹ c` (Bertsekas's second-order multiplier
+    /// iteration), instead of `λ ← λ + ρc`: the violation then falls superlinearly instead of
+    /// by a constant factor per outer iteration.
+    pub newton_multipliers: bool,
 }
 
 impl Default for AlOptions {
@@ -52,6 +60,8 @@ impl Default for AlOptions {
             active_tol: 1e-7,
             second_order: true,
             max_step: f64::INFINITY,
+            decrease: 0.25,
+            newton_multipliers: true,
         }
     }
 }
@@ -184,6 +194,9 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
     let mut sw = vec![0.0; m];
     let use_newton = opts.second_order && p.has_hessian();
+    // Second-order multiplier steps until one outer iteration fails to cut the violation enough
+    // (inconsistent constraints make the dual unbounded, and its Newton steps diverge).
+    let mut dual_ok = use_newton && opts.newton_multipliers;
     while outer < opts.max_outer {
         outer += 1;
         let out = if use_newton {
@@ -214,6 +227,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     grad_tol: inner_tol,
                     max_iter: opts.max_inner,
                     max_step: opts.max_step,
+                    min_iter: usize::from(opts.newton_multipliers && outer > 1),
                 },
             )
         } else {
@@ -247,6 +261,12 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         }
         let f_now = p.values(x, &mut c);
         evaluations += 1;
+        let dual_step = if dual_ok && m > 0 {
+            augment(f_now, &c, &lambda, rho, &senses, &mut y, &mut sw);
+            dual_newton_multipliers(p, x, &c, &lambda, &y, &sw, rho)
+        } else {
+            None
+        };
         let mut viol: f64 = 0.0;
         for i in 0..m {
             match senses[i] {
@@ -259,6 +279,9 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     lambda[i] = (lambda[i] + rho * c[i]).max(0.0);
                 }
             }
+        }
+        if let Some(l) = dual_step {
+            lambda = l;
         }
         on_outer(&OuterIterate {
             outer,
@@ -276,7 +299,8 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             status = AlStatus::Converged;
             break;
         }
-        if viol > 0.25 * viol_prev {
+        if viol > opts.decrease * viol_prev {
+            dual_ok = false;
             if rho >= opts.rho_max && viol > opts.feasibility_tol && outer > 5 {
                 status = AlStatus::Infeasible;
                 break;
@@ -334,6 +358,59 @@ pub fn kkt_residual<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> f64 {
     let mut g = vec![0.0; p.n()];
     p.gradient(x, lambda, &mut g);
     g.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// The second-order multiplier update at `x`, the minimiser of `Φ` for multipliers `lambda`
+/// (`c` its row values, `y` and `s` the weights [`augment`] wrote there): a Newton step on the
+/// dual function, whose gradient is `c_A` and whose Hessian is `−J_A ∇²Φ⁻¹ J_Aᵀ` on the rows
+/// `A` with an active penalty. Inequality multipliers are clipped at zero, inactive ones are
+/// zero. `None` when `∇²Φ` is not positive definite or the dual Hessian is singular (the caller
+/// falls back to `λ + ρc`).
+const DUAL_STEP_CAP: f64 = 10.0;
+
+fn dual_newton_multipliers<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    c: &[f64],
+    lambda: &[f64],
+    y: &[f64],
+    s: &[f64],
+    rho: f64,
+) -> Option<Vec<f64>> {
+    let (n, m) = (p.n(), p.m());
+    let active: Vec<usize> = (0..m).filter(|&i| s[i] > 0.0).collect();
+    if active.is_empty() {
+        return None;
+    }
+    let mut h = vec![0.0; n * n];
+    p.hessian(x, y, s, &mut h);
+    let ch = DMatrix::from_row_slice(n, n, &h).cholesky()?;
+    let (_, rows) = jacobian_rows(p, x, &active);
+    let k = active.len();
+    let jt = DMatrix::from_fn(n, k, |i, j| rows[j][i]);
+    let hinv_jt = ch.solve(&jt);
+    let dual = jt.transpose() * hinv_jt;
+    let ca = DVector::from_fn(k, |j, _| c[active[j]]);
+    let mut step = dual.cholesky()?.solve(&ca);
+    if step.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    // Near-singular dual Hessians (nearly dependent or inconsistent rows) give huge steps: keep
+    // the step within a few first-order steps `ρc`.
+    let cap = DUAL_STEP_CAP * rho * ca.amax();
+    let size = step.amax();
+    if size > cap {
+        step *= cap / size;
+    }
+    let mut out = vec![0.0; m];
+    for (j, &i) in active.iter().enumerate() {
+        let l = lambda[i] + step[j];
+        out[i] = match p.sense(i) {
+            Sense::Equal => l,
+            Sense::LessEq => l.max(0.0),
+        };
+    }
+    Some(out)
 }
 
 /// Rows of the constraint Jacobian, by differencing `gradient` with unit weights.
@@ -465,5 +542,62 @@ mod tests {
         assert_eq!(out.status, AlStatus::Converged);
         assert!((x[0] - 0.8).abs() < 1e-8, "{x:?}");
         assert!((out.lambda[0] + 0.4).abs() < 1e-7 && (out.lambda[1] - 1.2).abs() < 1e-7);
+    }
+
+    /// min x + 2y on the unit circle x² + y² = 1: x* = −(1, 2)/√5, λ* = √5/2; with the
+    /// exact Hessian, so the multiplier method runs Newton inner steps.
+    struct Circle;
+    impl Nlp for Circle {
+        fn n(&self) -> usize {
+            2
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn sense(&self, _i: usize) -> Sense {
+            Sense::Equal
+        }
+        fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
+            c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
+            x[0] + 2.0 * x[1]
+        }
+        fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
+            g[0] = 1.0 + 2.0 * y[0] * x[0];
+            g[1] = 2.0 + 2.0 * y[0] * x[1];
+        }
+        fn has_hessian(&self) -> bool {
+            true
+        }
+        fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
+            let j = [2.0 * x[0], 2.0 * x[1]];
+            for a in 0..2 {
+                h[3 * a] += 2.0 * y[0];
+                for b in 0..2 {
+                    h[2 * a + b] += s[0] * j[a] * j[b];
+                }
+            }
+        }
+    }
+
+    /// The dual Newton update reaches the multiplier in fewer outer iterations than `λ + ρc`
+    /// from a low penalty, and both reach the closed form.
+    #[test]
+    fn second_order_multipliers_converge_faster() {
+        let run = |newton_multipliers: bool| {
+            let mut x = vec![-0.3, -0.8];
+            let opts = AlOptions {
+                rho_initial: 1.0,
+                newton_multipliers,
+                ..AlOptions::default()
+            };
+            let out = augmented_lagrangian(&mut Circle, &mut x, None, opts);
+            assert_eq!(out.status, AlStatus::Converged);
+            let r5 = 5.0_f64.sqrt();
+            assert!((x[0] + 1.0 / r5).abs() < 1e-8 && (x[1] + 2.0 / r5).abs() < 1e-8, "{x:?}");
+            assert!((out.lambda[0] - r5 / 2.0).abs() < 1e-8, "{:?}", out.lambda);
+            out.outer_iterations
+        };
+        let (second, first) = (run(true), run(false));
+        assert!(second < first, "{second} vs {first}");
     }
 }

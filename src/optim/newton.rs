@@ -18,6 +18,9 @@ pub struct NewtonOptions {
     pub max_iter: usize,
     /// Largest step `‖d‖∞` (a longer Newton step is scaled back to it).
     pub max_step: f64,
+    /// Steps taken even when the gradient is already below `grad_tol` (a multiplier update that
+    /// moves the minimiser by less than the tolerance still moves it).
+    pub min_iter: usize,
 }
 
 /// Minimises `f` from `x` (updated in place). `eval(x, g)` returns `f(x)` and, when `g` is given,
@@ -55,7 +58,7 @@ pub fn newton(
                 let dmax = (0..n)
                     .fold(0.0_f64, |m, i| m.max(hm[(i, i)].abs()))
                     .max(1e-12);
-                if inf_norm(&g) <= opts.grad_tol {
+                if inf_norm(&g) <= opts.grad_tol && iterations >= opts.min_iter {
                     // A stationary point: a minimum unless the Hessian has a clearly negative
                     // eigenvalue (a saddle, e.g. a straight rod under compression by symmetry);
                     // then step along that direction while it lowers f.
@@ -219,6 +222,7 @@ mod tests {
                 grad_tol: 1e-10,
                 max_iter: 100,
                 max_step: f64::INFINITY,
+                min_iter: 0,
             },
         );
         assert_eq!(out.status, BfgsStatus::Converged);

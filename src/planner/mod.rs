@@ -285,6 +285,7 @@ impl Planner {
         // the previous shape and must stay on its branch of equilibria (unlimited steps let a
         // solve jump to another equilibrium on the mesh case).
         static_options.al.max_step = static_options.al.max_step.min(0.1);
+
         let start = end_shape(case, "start", &options.start, &static_options)?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
@@ -371,6 +372,8 @@ impl Planner {
             active_tol: 1e-7,
             second_order: self.options.optimiser == spec::Optimiser::Newton,
             max_step: f64::INFINITY,
+            decrease: 0.25,
+            newton_multipliers: false,
         };
         let mut z = z0;
         for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
