@@ -138,15 +138,21 @@ pub fn newton(
                     for i in 0..n {
                         xn[i] = x[i] + alpha * d[i];
                     }
-                    let fv = eval(&xn, None);
+                    // The full step usually succeeds: its gradient comes with it.
+                    let full = alpha == 1.0;
+                    let fv = eval(&xn, if full { Some(&mut gt) } else { None });
                     evals += 1;
                     if fv.is_finite() && fv <= f + 1e-4 * alpha * slope {
-                        accepted = Some((fv, false));
+                        accepted = Some((fv, full));
                         break;
                     }
                     if fv.is_finite() && (fv - f).abs() <= 1e-12 * f.abs().max(1.0) {
-                        let fg = eval(&xn, Some(&mut gt));
-                        evals += 1;
+                        let fg = if full {
+                            fv
+                        } else {
+                            evals += 1;
+                            eval(&xn, Some(&mut gt))
+                        };
                         if inf_norm(&gt) < 0.5 * g_norm {
                             accepted = Some((fg, true));
                             break;
