@@ -794,12 +794,12 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         if margin < 0.0 {
             return Err(v.err(f("margin"), "must be non-negative"));
         }
-        let ob = Arc::new(Obstacle {
-            name: o.name.clone().unwrap_or_else(|| format!("obstacle{i}")),
+        let ob = Arc::new(Obstacle::new(
+            o.name.clone().unwrap_or_else(|| format!("obstacle{i}")),
             shape,
             position,
             rotation,
-        });
+        ));
         obstacles.push(ob.clone());
         constraints.push(Box::new(ObstacleConstraint {
             obstacle: ob,

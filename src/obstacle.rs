@@ -52,10 +52,9 @@ pub struct Obstacle {
     pub name: String,
     /// Local geometry.
     pub shape: ObstacleShape,
-    /// World position of the local origin.
-    pub position: [f64; 3],
-    /// Rotation as an axis–angle vector (radians).
-    pub rotation: [f64; 3],
+    position: [f64; 3],
+    rotation: [f64; 3],
+    pose: Pose,
 }
 
 fn v3(p: [f64; 3]) -> Vector {
@@ -63,9 +62,31 @@ fn v3(p: [f64; 3]) -> Vector {
 }
 
 impl Obstacle {
+    /// `shape` placed with its local origin at `position`, rotated by the axis–angle vector
+    /// `rotation` (radians).
+    pub fn new(name: String, shape: ObstacleShape, position: [f64; 3], rotation: [f64; 3]) -> Self {
+        Obstacle {
+            name,
+            shape,
+            position,
+            rotation,
+            pose: Pose::new(v3(position), v3(rotation)),
+        }
+    }
+
+    /// World position of the local origin.
+    pub fn position(&self) -> [f64; 3] {
+        self.position
+    }
+
+    /// Rotation as an axis–angle vector (radians).
+    pub fn rotation(&self) -> [f64; 3] {
+        self.rotation
+    }
+
     /// The parry pose of the obstacle.
     pub fn pose(&self) -> Pose {
-        Pose::new(v3(self.position), v3(self.rotation))
+        self.pose
     }
 
     /// Projection of world point `pv` onto the surface, `None` for a half-space (analytic).

@@ -196,12 +196,12 @@ fn each_energy_term_gradient_matches_finite_differences() {
 }
 
 fn obstacle(name: &str, shape: ObstacleShape, position: [f64; 3]) -> Arc<Obstacle> {
-    Arc::new(Obstacle {
-        name: name.into(),
+    Arc::new(Obstacle::new(
+        name.into(),
         shape,
         position,
-        rotation: [0.3, -0.2, 0.5],
-    })
+        [0.3, -0.2, 0.5],
+    ))
 }
 
 fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
@@ -388,10 +388,7 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
         ObstacleShape::HalfSpace([0.0, 0.0, 1.0]),
         [0.0, 0.0, 0.8],
     );
-    let h = Obstacle {
-        rotation: [0.0; 3],
-        ..(*h).clone()
-    };
+    let h = Obstacle::new(h.name.clone(), h.shape.clone(), h.position(), [0.0; 3]);
     assert!((h.signed_distance([0.0, 0.0, 1.3]).0 - 0.5).abs() < 1e-12);
     assert!((h.signed_distance([5.0, 1.0, 0.3]).0 + 0.5).abs() < 1e-12);
     // A point deep inside a closed oriented mesh is recognised as inside.
@@ -405,12 +402,12 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
         TriMeshFlags::ORIENTED,
     )
     .unwrap();
-    let mo = Obstacle {
-        name: "m".into(),
-        shape: ObstacleShape::TriMesh(Arc::new(mesh)),
-        position: [0.0; 3],
-        rotation: [0.0; 3],
-    };
+    let mo = Obstacle::new(
+        "m".into(),
+        ObstacleShape::TriMesh(Arc::new(mesh)),
+        [0.0; 3],
+        [0.0; 3],
+    );
     assert!((mo.signed_distance([0.1, 0.0, 0.0]).0 + 0.4).abs() < 1e-12);
     assert!((mo.signed_distance([0.0, 0.0, 0.9]).0 - 0.4).abs() < 1e-12);
 }

@@ -206,7 +206,7 @@ pub fn obstacles_update(
     let entities = obstacles
         .iter()
         .map(|o| {
-            let rot = axis_angle_matrix(o.rotation);
+            let rot = axis_angle_matrix(o.rotation());
             let mut e = SceneEntity {
                 timestamp: Some(stamp(t)),
                 frame_id: ROD_FRAME.into(),
@@ -217,7 +217,7 @@ pub fn obstacles_update(
                 ObstacleShape::Cuboid(c) => {
                     let h = c.half_extents;
                     e.cubes.push(CubePrimitive {
-                        pose: Some(pose_of(o.position, rot)),
+                        pose: Some(pose_of(o.position(), rot)),
                         size: Some(v3([2.0 * h.x, 2.0 * h.y, 2.0 * h.z])),
                         color: Some(grey),
                     });
@@ -225,7 +225,7 @@ pub fn obstacles_update(
                 ObstacleShape::Ball(b) => {
                     let d = 2.0 * b.radius;
                     e.spheres.push(SpherePrimitive {
-                        pose: Some(pose_of(o.position, rot)),
+                        pose: Some(pose_of(o.position(), rot)),
                         size: Some(v3([d, d, d])),
                         color: Some(grey),
                     });
@@ -235,8 +235,8 @@ pub fn obstacles_update(
                     let b = [c.segment.b.x, c.segment.b.y, c.segment.b.z];
                     let wa = apply(rot, a).map(|v| v);
                     let wb = apply(rot, b);
-                    let wa = [0, 1, 2].map(|i| wa[i] + o.position[i]);
-                    let wb = [0, 1, 2].map(|i| wb[i] + o.position[i]);
+                    let wa = [0, 1, 2].map(|i| wa[i] + o.position()[i]);
+                    let wb = [0, 1, 2].map(|i| wb[i] + o.position()[i]);
                     let d = 2.0 * c.radius;
                     for p in [wa, wb] {
                         e.spheres.push(SpherePrimitive {
@@ -264,7 +264,7 @@ pub fn obstacles_update(
                     let z_to_y = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]];
                     let d = 2.0 * c.radius;
                     e.cylinders.push(CylinderPrimitive {
-                        pose: Some(pose_of(o.position, mat_mul(rot, z_to_y))),
+                        pose: Some(pose_of(o.position(), mat_mul(rot, z_to_y))),
                         size: Some(v3([d, d, 2.0 * c.half_height])),
                         bottom_scale: 1.0,
                         top_scale: 1.0,
@@ -284,7 +284,7 @@ pub fn obstacles_update(
                     let m = frame_with_z(apply(rot, *n));
                     let th = 0.02 * length;
                     let nz = apply(rot, *n);
-                    let c = [0, 1, 2].map(|i| o.position[i] - 0.5 * th * nz[i]);
+                    let c = [0, 1, 2].map(|i| o.position()[i] - 0.5 * th * nz[i]);
                     e.cubes.push(CubePrimitive {
                         pose: Some(pose_of(c, m)),
                         size: Some(v3([4.0 * length, 4.0 * length, th])),
@@ -310,7 +310,7 @@ fn triangles(
 ) -> TriangleListPrimitive {
     let _ = o;
     TriangleListPrimitive {
-        pose: Some(pose_of(o.position, rot)),
+        pose: Some(pose_of(o.position(), rot)),
         points: idx
             .iter()
             .flat_map(|t| t.iter().map(|&i| v[i as usize]))

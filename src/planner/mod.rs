@@ -644,8 +644,21 @@ impl Planner {
                 .filter(|o| o.clearance < -tol)
                 .map(|o| o.k)
                 .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k));
+
             for kw in worst_k.collect::<Vec<_>>() {
-                for k in [kw - h, kw, kw + h] {
+                // The grid's worst k and its grid neighbours, and the midpoints of the
+                // optimiser's interval holding it and of the intervals on either side: the
+                // sample spacing halves where the path tunnels.
+                let mut cand = vec![kw - h, kw, kw + h];
+                let i = ks
+                    .iter()
+                    .rposition(|&q| q <= kw)
+                    .unwrap_or(0)
+                    .min(ks.len() - 2);
+                for j in i.saturating_sub(1)..(i + 2).min(ks.len() - 1) {
+                    cand.push(0.5 * (ks[j] + ks[j + 1]));
+                }
+                for k in cand {
                     if k > 0.0 && k < 1.0 && !ks.iter().any(|&q| (q - k).abs() < 0.25 * h) {
                         ks.push(k);
                         added.push(k);
