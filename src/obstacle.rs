@@ -102,12 +102,28 @@ impl Obstacle {
         })
     }
 
+    /// Projection of the local point `pl` onto the surface, in the local frame (`None` for a
+    /// half-space).
+    fn project_local(&self, pl: Vector) -> Option<parry3d_f64::query::PointProjection> {
+        Some(match &self.shape {
+            ObstacleShape::HalfSpace(_) => return None,
+            ObstacleShape::Cuboid(s) => s.project_local_point(pl, false),
+            ObstacleShape::Ball(s) => s.project_local_point(pl, false),
+            ObstacleShape::Capsule(s) => s.project_local_point(pl, false),
+            ObstacleShape::Cylinder(s) => s.project_local_point(pl, false),
+            ObstacleShape::ConvexHull(s) => s.project_local_point(pl, false),
+            ObstacleShape::TriMesh(s) => s.project_local_point(pl, false),
+        })
+    }
+
     /// Signed distance from world point `p` to the obstacle's surface (negative inside) and its
     /// gradient with respect to `p` (unit, pointing away from the obstacle).
     pub fn signed_distance(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
-        let pose = self.pose();
+        let pose = &self.pose;
         let pv = v3(p);
-        let Some(proj) = self.project(&pose, pv) else {
+        // In the obstacle's frame: one transform in, the normal rotated out.
+        let pl = pose.inverse_transform_point(pv);
+        let Some(proj) = self.project_local(pl) else {
             let ObstacleShape::HalfSpace(n) = &self.shape else {
                 unreachable!()
             };
@@ -115,13 +131,13 @@ impl Obstacle {
             let d = (pv - pose.translation).dot(nw);
             return (d, [nw.x, nw.y, nw.z]);
         };
-        let diff = pv - proj.point;
+        let diff = pl - proj.point;
         let dist = diff.length();
         if dist < 1e-14 {
             // On the surface: the gradient of the signed distance by central differences.
             return (0.0, self.fallback_normal(p));
         }
-        let n = diff / dist;
+        let n = pose.rotation * (diff / dist);
         if proj.is_inside {
             (-dist, [-n.x, -n.y, -n.z])
         } else {

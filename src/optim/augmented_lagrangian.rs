@@ -11,7 +11,7 @@
 //! [`AlOptions::rho_max`] (beyond it multiplier updates become noise). A final least-squares
 //! estimate of the multipliers from `∇f = −Jᵀλ` on the active set polishes them.
 
-use super::bfgs::{BfgsOptions, BfgsStatus, bfgs};
+use super::bfgs::{BfgsOptions, BfgsStatus, bfgs, inf_norm};
 use super::newton::{NewtonOptions, newton};
 use super::nlp::{Nlp, Sense};
 use nalgebra::{DMatrix, DVector};
@@ -313,19 +313,18 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         viol_prev = viol;
         inner_tol = (inner_tol * 0.1).max(opts.optimality_tol);
     }
+    // Everything below is evaluated at x: one evaluation serves every gradient.
     let f = p.values(x, &mut c);
-    let polished = least_squares_multipliers(p, x, &c, &lambda, opts.active_tol);
+    let polished = least_squares_multipliers_at(p, x, &c, &lambda, opts.active_tol);
+    let mut g = vec![0.0; n];
+    p.gradient(x, &lambda, &mut g);
+    let kkt_now = inf_norm(&g);
     let (lambda, kkt) = match polished {
-        Some((l, r)) if r <= kkt_residual(p, x, &lambda) => (l, r),
-        _ => {
-            let r = kkt_residual(p, x, &lambda);
-            (lambda, r)
-        }
+        Some((l, r)) if r <= kkt_now => (l, r),
+        _ => (lambda, kkt_now),
     };
     let max_violation = violation(p, &c);
     let grad_scale = {
-        let mut g = vec![0.0; n];
-        p.values(x, &mut c);
         p.gradient(x, &vec![0.0; m], &mut g);
         g.iter().fold(1.0_f64, |acc, v| acc.max(v.abs()))
     };
@@ -386,7 +385,7 @@ fn dual_newton_multipliers<P: Nlp>(
     let mut h = vec![0.0; n * n];
     p.hessian(x, y, s, &mut h);
     let ch = DMatrix::from_row_slice(n, n, &h).cholesky()?;
-    let (_, rows) = jacobian_rows(p, x, &active);
+    let (_, rows) = jacobian_rows_at(p, x, &active);
     let k = active.len();
     let jt = DMatrix::from_fn(n, k, |i, j| rows[j][i]);
     let hinv_jt = ch.solve(&jt);
@@ -416,9 +415,14 @@ fn dual_newton_multipliers<P: Nlp>(
 
 /// Rows of the constraint Jacobian, by differencing `gradient` with unit weights.
 pub fn jacobian_rows<P: Nlp>(p: &mut P, x: &[f64], rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let (n, m) = (p.n(), p.m());
-    let mut c = vec![0.0; m];
+    let mut c = vec![0.0; p.m()];
     p.values(x, &mut c);
+    jacobian_rows_at(p, x, rows)
+}
+
+/// [`jacobian_rows`] when the last [`Nlp::values`] call was at `x`.
+pub(crate) fn jacobian_rows_at<P: Nlp>(p: &mut P, x: &[f64], rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let (n, m) = (p.n(), p.m());
     let mut g0 = vec![0.0; n];
     let zero = vec![0.0; m];
     p.gradient(x, &zero, &mut g0);
@@ -454,12 +458,25 @@ pub fn least_squares_multipliers<P: Nlp>(
     lambda: &[f64],
     tol: f64,
 ) -> Option<(Vec<f64>, f64)> {
+    let mut cv = vec![0.0; p.m()];
+    p.values(x, &mut cv);
+    least_squares_multipliers_at(p, x, c, lambda, tol)
+}
+
+/// [`least_squares_multipliers`] when the last [`Nlp::values`] call was at `x`.
+fn least_squares_multipliers_at<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    c: &[f64],
+    lambda: &[f64],
+    tol: f64,
+) -> Option<(Vec<f64>, f64)> {
     let m = p.m();
     if m == 0 {
         return None;
     }
     let mut active = active_rows(p, c, lambda, tol);
-    let (g0, rows_all) = jacobian_rows(p, x, &active);
+    let (g0, rows_all) = jacobian_rows_at(p, x, &active);
     let n = g0.len();
     let mut rows: Vec<(usize, Vec<f64>)> = active.drain(..).zip(rows_all).collect();
     for _ in 0..rows.len() + 1 {

@@ -2,7 +2,7 @@
 //! says its Hessian is exact, else central differences of analytic gradients), reduced to the
 //! tangent space of the strongly active constraints.
 
-use super::augmented_lagrangian::jacobian_rows;
+use super::augmented_lagrangian::jacobian_rows_at;
 use super::nlp::{Nlp, Sense};
 use nalgebra::DMatrix;
 
@@ -39,6 +39,8 @@ pub fn reduced_hessian_eigenvalues<P: Nlp>(
                 hess[(i, j)] = (gp[i] - gm[i]) / (2.0 * step);
             }
         }
+        // Back to x for the constraint rows below.
+        p.values(x, &mut c);
     }
     let hess = 0.5 * (&hess + hess.transpose());
     let rows: Vec<usize> = (0..m)
@@ -47,7 +49,7 @@ pub fn reduced_hessian_eigenvalues<P: Nlp>(
     let z = if rows.is_empty() {
         DMatrix::identity(n, n)
     } else {
-        let (_, jr) = jacobian_rows(p, x, &rows);
+        let (_, jr) = jacobian_rows_at(p, x, &rows);
         let j = DMatrix::from_fn(rows.len(), n, |r, k| jr[r][k]);
         null_space(&j)
     };
