@@ -1,5 +1,5 @@
-//! Speed of planning and replay on the paper's planar example, and the cost of the MCAP log
-//! (figures quoted in the README).
+//! Speed of planning and replay on the paper's planar example and the three 3D cases, and the
+//! cost of the MCAP log (figures quoted in the README).
 //!
 //! Run: `cargo bench --bench plan`
 
@@ -61,6 +61,19 @@ fn benches(c: &mut Criterion) {
             )
         })
     });
+    g.finish();
+    let mut g = c.benchmark_group("3D cases");
+    g.sample_size(10);
+    for name in [
+        "plan_cable_over_bar",
+        "plan_cable_around_pillar",
+        "plan_cable_past_mesh",
+    ] {
+        let (_, pl) = planner(&format!("{name}.json"));
+        g.bench_function(format!("{name}: plan + verify + replay, no log"), |b| {
+            b.iter(|| pl.run(&mut Silent))
+        });
+    }
     g.finish();
 }
 

@@ -80,6 +80,21 @@ impl Model {
         }
     }
 
+    /// The constant part of the energy Hessian: `Σ_q wf θ'θ' + wt ψ'ψ' + we εε` terms.
+    pub(crate) fn assemble_constant_hessian(&self) -> Vec<f64> {
+        let n = self.n();
+        let mut h = vec![0.0; n * n];
+        let spatial = self.layout.spatial;
+        self.assemble_local(&mut h, |q, hq| {
+            hq[DTH][DTH] = self.wf[q];
+            hq[EPS][EPS] = self.we[q];
+            if spatial {
+                hq[DPS][DPS] = self.wt[q];
+            }
+        });
+        h
+    }
+
     /// Adds `scale · ∇²E` to `h` (row-major `n×n`), where `E` is the objective's energy
     /// (dimensionless) of the evaluated `shape`. For [`Objective::Internal`] the work of point
     /// loads is included (its curvature comes from the positions').
@@ -91,11 +106,14 @@ impl Model {
         h: &mut [f64],
     ) {
         let spatial = self.layout.spatial;
+        for (hv, kv) in h.iter_mut().zip(&self.constant_hessian) {
+            *hv += scale * kv;
+        }
         self.assemble_local(h, |q, hq| {
             let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
             let (dph, dps, _eps) = (shape.dph[q], shape.dps[q], shape.eps[q]);
             let one = 1.0 + shape.eps[q];
-            let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
+            let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
             let omega = dph * ct + dps;
             // Gravity: wg (1+ε) sθ cφ.
             hq[TH][TH] = -wg * one * st * cp;
@@ -103,9 +121,8 @@ impl Model {
             hq[PH][PH] = -wg * one * st * cp;
             hq[TH][EPS] = wg * ct * cp;
             hq[PH][EPS] = -wg * st * sp;
-            // Flexure: ½ wf (θ'² + φ'² sθ²).
-            hq[DTH][DTH] = wf;
-            hq[EPS][EPS] = we;
+            // Flexure: ½ wf (θ'² + φ'² sθ²); its θ'θ' part, torsion's ψ'ψ' and extension's εε
+            // are constant (in `constant_hessian`).
             if spatial {
                 let c2 = ct * ct - st * st;
                 hq[TH][TH] +=
@@ -114,7 +131,6 @@ impl Model {
                 hq[TH][DPS] = -wt * dph * st;
                 hq[DPH][DPH] = wf * st * st + wt * ct * ct;
                 hq[DPH][DPS] = wt * ct;
-                hq[DPS][DPS] = wt;
             }
             for r in hq.iter_mut() {
                 for v in r.iter_mut() {

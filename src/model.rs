@@ -67,6 +67,9 @@ pub struct Model {
     pub(crate) wg: Vec<f64>,
     /// `∫₀¹ D L³/Rf`: the base term of the gravitational energy.
     pub(crate) gravity_total: f64,
+    /// The part of the energy Hessian that does not depend on the coefficients (flexure in θ',
+    /// torsion in ψ', extension in ε), row-major `n×n`.
+    pub(crate) constant_hessian: Vec<f64>,
 }
 
 impl Model {
@@ -101,7 +104,7 @@ impl Model {
         }
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
-        Model {
+        let mut model = Model {
             rod,
             layout,
             mesh,
@@ -115,7 +118,10 @@ impl Model {
             we,
             wg,
             gravity_total,
-        }
+            constant_hessian: Vec::new(),
+        };
+        model.constant_hessian = model.assemble_constant_hessian();
+        model
     }
 
     /// Number of unknowns.
