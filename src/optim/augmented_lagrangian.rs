@@ -197,6 +197,8 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     // Second-order multiplier steps until one outer iteration fails to cut the violation enough
     // (inconsistent constraints make the dual unbounded, and its Newton steps diverge).
     let mut dual_ok = use_newton && opts.newton_multipliers;
+    // The point and ∇²Φ of Newton's last Hessian.
+    let mut last_hessian: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
     while outer < opts.max_outer {
         outer += 1;
         let out = if use_newton {
@@ -206,6 +208,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             // and `hess` comes right after an `eval` at its point (the problem's state, `y` and
             // the penalty weights are that evaluation's).
             let state = std::cell::RefCell::new((&mut *p, &mut c, &mut y, &mut sw));
+            let last = std::cell::RefCell::new(&mut last_hessian);
             newton(
                 |xv, g| {
                     let mut st = state.borrow_mut();
@@ -221,6 +224,14 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     let mut st = state.borrow_mut();
                     let (p, _, y, sw) = &mut *st;
                     p.hessian(xv, y, sw, h);
+                    if dual_ok {
+                        // Kept for the multiplier step, which needs ∇²Φ at the final point.
+                        let mut l = last.borrow_mut();
+                        l.0.clear();
+                        l.0.extend_from_slice(xv);
+                        l.1.clear();
+                        l.1.extend_from_slice(h);
+                    }
                 },
                 x,
                 NewtonOptions {
@@ -263,7 +274,12 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         evaluations += 1;
         let dual_step = if dual_ok && m > 0 {
             augment(f_now, &c, &lambda, rho, &senses, &mut y, &mut sw);
-            dual_newton_multipliers(p, x, &c, &lambda, &y, &sw, rho)
+            // Newton's Hessian at x used these multipliers and this penalty: it is ∇²Φ here.
+            if last_hessian.0.as_slice() != &x[..] {
+                last_hessian.1 = vec![0.0; n * n];
+                p.hessian(x, &y, &sw, &mut last_hessian.1);
+            }
+            dual_newton_multipliers(p, x, &c, &lambda, &sw, rho, &last_hessian.1)
         } else {
             None
         };
@@ -360,31 +376,31 @@ pub fn kkt_residual<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> f64 {
     g.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
+/// Largest dual Newton step, in first-order steps `ρ‖c_A‖∞`.
+const DUAL_STEP_CAP: f64 = 10.0;
+
 /// The second-order multiplier update at `x`, the minimiser of `Φ` for multipliers `lambda`
-/// (`c` its row values, `y` and `s` the weights [`augment`] wrote there): a Newton step on the
+/// (`c` its row values, `s` the penalty weights [`augment`] wrote there, `hessian` = `∇²Φ(x)`,
+/// the last [`Nlp::values`] call at `x`): a Newton step on the
 /// dual function, whose gradient is `c_A` and whose Hessian is `−J_A ∇²Φ⁻¹ J_Aᵀ` on the rows
 /// `A` with an active penalty. Inequality multipliers are clipped at zero, inactive ones are
 /// zero. `None` when `∇²Φ` is not positive definite or the dual Hessian is singular (the caller
 /// falls back to `λ + ρc`).
-const DUAL_STEP_CAP: f64 = 10.0;
-
 fn dual_newton_multipliers<P: Nlp>(
     p: &mut P,
     x: &[f64],
     c: &[f64],
     lambda: &[f64],
-    y: &[f64],
     s: &[f64],
     rho: f64,
+    hessian: &[f64],
 ) -> Option<Vec<f64>> {
     let (n, m) = (p.n(), p.m());
     let active: Vec<usize> = (0..m).filter(|&i| s[i] > 0.0).collect();
     if active.is_empty() {
         return None;
     }
-    let mut h = vec![0.0; n * n];
-    p.hessian(x, y, s, &mut h);
-    let ch = DMatrix::from_row_slice(n, n, &h).cholesky()?;
+    let ch = DMatrix::from_row_slice(n, n, hessian).cholesky()?;
     let (_, rows) = jacobian_rows_at(p, x, &active);
     let k = active.len();
     let jt = DMatrix::from_fn(n, k, |i, j| rows[j][i]);
