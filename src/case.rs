@@ -1064,8 +1064,8 @@ pub fn default_start(layout: &Layout, delta: f64, base: [f64; 3]) -> Vec<f64> {
     let nb = layout.nb();
     a[0] = delta;
     a[1] = -2.0 * delta;
-    for i in 2..nb {
-        a[i] = delta * 0.05 * (1.0 + (i as f64 * 0.7).sin());
+    for (i, ai) in a.iter_mut().enumerate().take(nb).skip(2) {
+        *ai = delta * 0.05 * (1.0 + (i as f64 * 0.7).sin());
     }
     if let Some(o) = layout.offset(Field::Phi) {
         a[o] = 0.3;

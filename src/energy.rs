@@ -141,8 +141,8 @@ impl Model {
                 t.work += (0..3)
                     .map(|k| ld.force[k] * (x[k] - ld.reference[k]))
                     .sum::<f64>();
-                for k in 0..3 {
-                    v[b][k] -= ld.force[k];
+                for (vk, fk) in v[b].iter_mut().zip(ld.force) {
+                    *vk -= fk;
                 }
             }
             if objective == Objective::Internal

@@ -141,8 +141,8 @@ impl Model {
         if objective == Objective::Internal && !self.loads.is_empty() {
             let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
             for (ld, &b) in self.loads.iter().zip(&self.load_boundary) {
-                for k in 0..3 {
-                    v[b][k] -= scale * ld.force[k];
+                for (vk, fk) in v[b].iter_mut().zip(ld.force) {
+                    *vk -= scale * fk;
                 }
             }
             self.add_positions_hessian(shape, &v, h);

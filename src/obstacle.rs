@@ -172,9 +172,12 @@ impl Obstacle {
     }
 }
 
+/// Vertices and triangles of a mesh.
+pub type MeshData = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Reads a Wavefront OBJ file's `v` and `f` records (faces are triangulated as fans; texture and
 /// normal indices are ignored).
-pub fn read_obj(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
+pub fn read_obj(text: &str) -> Result<MeshData, String> {
     let mut verts = Vec::new();
     let mut faces = Vec::new();
     for (ln, line) in text.lines().enumerate() {

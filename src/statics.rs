@@ -197,8 +197,8 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
                 if li > 0.0 {
                     let x = shape.positions[b].map(|v| v * l);
                     let (_, n) = ob.obstacle.signed_distance(x);
-                    for c in 0..3 {
-                        r.force[c] += li * n[c] * fu;
+                    for (fc, nc) in r.force.iter_mut().zip(n) {
+                        *fc += li * nc * fu;
                     }
                 }
             }
@@ -212,13 +212,13 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
         // F_base + Σ F_constraints + Σ p_loads − (∫D ds) x̂ = 0 (gravity along −x).
         let mut f = [0.0; 3];
         for r in &out {
-            for c in 0..3 {
-                f[c] -= r.force[c];
+            for (fc, rc) in f.iter_mut().zip(r.force) {
+                *fc -= rc;
             }
         }
         for ld in &m.loads {
-            for c in 0..3 {
-                f[c] -= ld.force[c] * fu;
+            for (fc, lc) in f.iter_mut().zip(ld.force) {
+                *fc -= lc * fu;
             }
         }
         f[0] += m.rod.weight.mean() * l;

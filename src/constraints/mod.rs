@@ -48,8 +48,8 @@ impl Adjoint {
     /// Adds `w · v` to the vector at boundary `b`.
     #[inline]
     pub fn add_pos(&mut self, b: usize, w: f64, v: [f64; 3]) {
-        for k in 0..3 {
-            self.pos[b][k] += w * v[k];
+        for (p, vk) in self.pos[b].iter_mut().zip(v) {
+            *p += w * vk;
         }
     }
 
