@@ -296,7 +296,16 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                 }
             }
         }
-        if std::env::var("DBGAL").is_ok() { eprintln!("DBGAL outer {outer} viol {viol:.2e} rho {rho:.0e} inner_it {} evals {} gn {:.2e} st {:?} dual {}", out.iterations, out.evaluations, out.grad_norm, out.status, dual_step.is_some()); }
+        if std::env::var("DBGAL").is_ok() {
+            eprintln!(
+                "DBGAL outer {outer} viol {viol:.2e} rho {rho:.0e} inner_it {} evals {} gn {:.2e} st {:?} dual {}",
+                out.iterations,
+                out.evaluations,
+                out.grad_norm,
+                out.status,
+                dual_step.is_some()
+            );
+        }
         if let Some(l) = dual_step {
             lambda = l;
         }
@@ -437,7 +446,11 @@ pub fn jacobian_rows<P: Nlp>(p: &mut P, x: &[f64], rows: &[usize]) -> (Vec<f64>,
 }
 
 /// [`jacobian_rows`] when the last [`Nlp::values`] call was at `x`.
-pub(crate) fn jacobian_rows_at<P: Nlp>(p: &mut P, x: &[f64], rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
+pub(crate) fn jacobian_rows_at<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    rows: &[usize],
+) -> (Vec<f64>, Vec<Vec<f64>>) {
     let (n, m) = (p.n(), p.m());
     let mut g0 = vec![0.0; n];
     let zero = vec![0.0; m];
@@ -627,7 +640,10 @@ mod tests {
             let out = augmented_lagrangian(&mut Circle, &mut x, None, opts);
             assert_eq!(out.status, AlStatus::Converged);
             let r5 = 5.0_f64.sqrt();
-            assert!((x[0] + 1.0 / r5).abs() < 1e-8 && (x[1] + 2.0 / r5).abs() < 1e-8, "{x:?}");
+            assert!(
+                (x[0] + 1.0 / r5).abs() < 1e-8 && (x[1] + 2.0 / r5).abs() < 1e-8,
+                "{x:?}"
+            );
             assert!((out.lambda[0] - r5 / 2.0).abs() < 1e-8, "{:?}", out.lambda);
             out.outer_iterations
         };

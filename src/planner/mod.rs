@@ -263,6 +263,25 @@ fn noise(seed: u64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// What the multiplier-method calls of one start have produced so far.
+struct Tally {
+    lambda: Option<Vec<f64>>,
+    status: AlStatus,
+    violation: f64,
+    evaluations: usize,
+}
+
+impl Tally {
+    /// Takes in one call's outcome; true when it failed numerically (nothing more to do).
+    fn absorb(&mut self, out: crate::optim::AlOutcome) -> bool {
+        self.evaluations += out.evaluations;
+        self.status = out.status;
+        self.violation = out.max_violation;
+        self.lambda = Some(out.lambda);
+        self.status == AlStatus::NumericalFailure
+    }
+}
+
 #[derive(Clone)]
 struct StartRun {
     z: Vec<f64>,
@@ -357,10 +376,12 @@ impl Planner {
             .copied()
             .fold(0.0_f64, f64::max)
             .max(1e-3);
-        let mut lambda: Option<Vec<f64>> = None;
-        let mut status = AlStatus::IterationLimit;
-        let mut violation = f64::INFINITY;
-        let mut evaluations = 0;
+        let mut tally = Tally {
+            lambda: None,
+            status: AlStatus::IterationLimit,
+            violation: f64::INFINITY,
+            evaluations: 0,
+        };
         let mut progress = Vec::new();
         let al = AlOptions {
             feasibility_tol: 1e-6,
@@ -390,7 +411,7 @@ impl Planner {
                 let mut probe = self.minimax_problem_at(ks.clone());
                 probe.beta = beta;
                 probe.mean_weight = mw;
-                augmented_lagrangian_observed(pp, &mut z, lambda.as_deref(), al, &mut |it| {
+                augmented_lagrangian_observed(pp, &mut z, tally.lambda.as_deref(), al, &mut |it| {
                     let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
                     let u = probe.energies();
                     let (j, &umax) = u
@@ -414,17 +435,13 @@ impl Planner {
                     ));
                 })
             };
-            evaluations += out.evaluations;
-            status = out.status;
-            violation = out.max_violation;
-            lambda = Some(out.lambda);
-            if status == AlStatus::NumericalFailure {
+            if tally.absorb(out) {
                 break;
             }
         }
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
-        if status != AlStatus::NumericalFailure && self.options.track_weight > 0.0 {
+        if tally.status != AlStatus::NumericalFailure && self.options.track_weight > 0.0 {
             p.track_weight = self.options.track_weight;
             // Targets keep the optimiser's safety margin from obstacles.
             let mut inflated = self.base.clone();
@@ -465,15 +482,11 @@ impl Planner {
                 let out = augmented_lagrangian_observed(
                     &mut p,
                     &mut z,
-                    lambda.as_deref(),
+                    tally.lambda.as_deref(),
                     al_t,
                     &mut |_| {},
                 );
-                evaluations += out.evaluations;
-                status = out.status;
-                violation = out.max_violation;
-                lambda = Some(out.lambda);
-                if status == AlStatus::NumericalFailure {
+                if tally.absorb(out) {
                     break;
                 }
             }
@@ -487,10 +500,10 @@ impl Planner {
             * unit;
         StartRun {
             z,
-            status,
-            violation,
+            status: tally.status,
+            violation: tally.violation,
             sampled_max,
-            evaluations,
+            evaluations: tally.evaluations,
             progress,
         }
     }
