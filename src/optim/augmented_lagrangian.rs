@@ -296,16 +296,6 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                 }
             }
         }
-        if std::env::var("DBGAL").is_ok() {
-            eprintln!(
-                "DBGAL outer {outer} viol {viol:.2e} rho {rho:.0e} inner_it {} evals {} gn {:.2e} st {:?} dual {}",
-                out.iterations,
-                out.evaluations,
-                out.grad_norm,
-                out.status,
-                dual_step.is_some()
-            );
-        }
         if let Some(l) = dual_step {
             lambda = l;
         }
