@@ -55,6 +55,7 @@ pub struct Obstacle {
     position: [f64; 3],
     rotation: [f64; 3],
     pose: Pose,
+    rotated: bool,
 }
 
 fn v3(p: [f64; 3]) -> Vector {
@@ -71,6 +72,7 @@ impl Obstacle {
             position,
             rotation,
             pose: Pose::new(v3(position), v3(rotation)),
+            rotated: rotation != [0.0; 3],
         }
     }
 
@@ -122,7 +124,11 @@ impl Obstacle {
         let pose = &self.pose;
         let pv = v3(p);
         // In the obstacle's frame: one transform in, the normal rotated out.
-        let pl = pose.inverse_transform_point(pv);
+        let pl = if self.rotated {
+            pose.inverse_transform_point(pv)
+        } else {
+            pv - pose.translation
+        };
         let Some(proj) = self.project_local(pl) else {
             let ObstacleShape::HalfSpace(n) = &self.shape else {
                 unreachable!()
@@ -137,7 +143,11 @@ impl Obstacle {
             // On the surface: the gradient of the signed distance by central differences.
             return (0.0, self.fallback_normal(p));
         }
-        let n = pose.rotation * (diff / dist);
+        let n = if self.rotated {
+            pose.rotation * (diff / dist)
+        } else {
+            diff / dist
+        };
         if proj.is_inside {
             (-dist, [-n.x, -n.y, -n.z])
         } else {
