@@ -34,25 +34,28 @@ impl Model {
     pub fn evaluate_into(&self, a: &[f64], shape: &mut Shape) {
         let nn = self.nodes();
         let lay = &self.layout;
-        for v in [
-            &mut shape.th,
-            &mut shape.dth,
-            &mut shape.ph,
-            &mut shape.dph,
-            &mut shape.dps,
-            &mut shape.eps,
-            &mut shape.sth,
-            &mut shape.cth,
-            &mut shape.sph,
-            &mut shape.cph,
-        ] {
-            v.clear();
-            v.resize(nn, 0.0);
-        }
         let at = lay.field(a, Field::Theta).expect("theta is always present");
         let ap = lay.field(a, Field::Phi);
         let aps = lay.field(a, Field::Psi);
         let ae = lay.field(a, Field::Eps);
+        // Fields the loop below overwrites only need the right length; the others are zero.
+        for (v, present) in [
+            (&mut shape.th, true),
+            (&mut shape.dth, true),
+            (&mut shape.sth, true),
+            (&mut shape.cth, true),
+            (&mut shape.ph, ap.is_some()),
+            (&mut shape.dph, ap.is_some()),
+            (&mut shape.sph, ap.is_some()),
+            (&mut shape.cph, true),
+            (&mut shape.dps, aps.is_some()),
+            (&mut shape.eps, ae.is_some()),
+        ] {
+            if !present {
+                v.clear();
+            }
+            v.resize(nn, 0.0);
+        }
         for q in 0..nn {
             let (e, de) = (self.e_at(q), self.de_at(q));
             let th = dot(at, e);
