@@ -318,13 +318,15 @@ pub struct SolverSpec {
     pub rho_max: f64,
     /// Outer iterations.
     pub max_outer: usize,
-    /// Inner BFGS iterations per outer iteration.
+    /// Inner (Newton) iterations per outer iteration.
     pub max_inner: usize,
     /// Size (radians) of the deterministic perturbation added to the natural state when no
     /// `shape` is given (the straight rod is stationary, see the README).
     pub perturbation: f64,
     /// Compute the stability verdict.
     pub stability: bool,
+    /// Second-order (dual Newton) multiplier updates instead of `λ + ρc`.
+    pub second_order_multipliers: bool,
 }
 
 impl Default for SolverSpec {
@@ -339,6 +341,7 @@ impl Default for SolverSpec {
             max_inner: al.max_inner,
             perturbation: 0.1,
             stability: true,
+            second_order_multipliers: al.newton_multipliers,
         }
     }
 }
@@ -862,6 +865,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             rho_max: sv.rho_max,
             max_outer: sv.max_outer,
             max_inner: sv.max_inner,
+            newton_multipliers: sv.second_order_multipliers,
             ..AlOptions::default()
         },
         stability: sv.stability,

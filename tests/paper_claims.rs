@@ -189,3 +189,34 @@ fn twisted_rod_kinks_into_a_loop_when_shortened() {
         assert!(loop_sol.energy.potential() <= plain.energy.potential() + 1e-9);
     }
 }
+
+/// `solver.second_order_multipliers`: both multiplier updates reach the same clamped-clamped
+/// elastica (energy to 1e-9 relative, shape to 1e-7 L), the second-order one in fewer outer
+/// iterations.
+#[test]
+fn both_multiplier_updates_reach_the_same_shape() {
+    let text = clamped(0.6, "");
+    let first_order = format!(
+        "{}, \"solver\": {{\"second_order_multipliers\": false}}}}",
+        text.trim_end().trim_end_matches('}')
+    );
+    let (c2, s2) = solve_json(&text, None);
+    let (_, s1) = solve_json(&first_order, None);
+    assert_eq!(s2.status, SolveStatus::Converged);
+    assert_eq!(s1.status, SolveStatus::Converged);
+    let (u1, u2) = (s1.energy.flexural, s2.energy.flexural);
+    assert!((u1 - u2).abs() <= 1e-9 * u2.abs(), "{u1} vs {u2}");
+    let (x1, x2) = (profile(&c2, &s1.a, 20), profile(&c2, &s2.a, 20));
+    let d = x1
+        .iter()
+        .zip(&x2)
+        .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
+        .fold(0.0, f64::max);
+    assert!(d <= 1e-7, "{d}");
+    assert!(
+        s2.outer_iterations < s1.outer_iterations,
+        "{} vs {}",
+        s2.outer_iterations,
+        s1.outer_iterations
+    );
+}
