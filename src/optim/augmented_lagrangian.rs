@@ -1,11 +1,13 @@
-//! The multiplier method (augmented Lagrangian, Powell–Hestenes–Rockafellar form) around BFGS.
+//! The multiplier method (augmented Lagrangian, Powell–Hestenes–Rockafellar form) around damped
+//! Newton steps (BFGS for problems without a Hessian).
 //!
 //! Convention: the Lagrangian is `ℒ(x, λ) = f(x) + Σᵢ λᵢ cᵢ(x)`, so at a KKT point
 //! `∇f + Σ λᵢ ∇cᵢ = 0` with `λᵢ ≥ 0` for inequality rows `cᵢ ≤ 0`. The augmented function is
 //!
 //! `Φ(x) = f + Σ_eq (λc + ρc²/2) + Σ_ineq (max(0, μ + ρc)² − μ²)/(2ρ)`
 //!
-//! and the updates are `λ ← λ + ρc`, `μ ← max(0, μ + ρc)`. The penalty `ρ` starts at
+//! and the updates are `λ ← λ + ρc`, `μ ← max(0, μ + ρc)`, or, with Newton inner steps and
+//! [`AlOptions::newton_multipliers`], a Newton step on the dual function. The penalty `ρ` starts at
 //! [`AlOptions::rho_initial`] (high: a small penalty lets a compressed straight rod sit at its
 //! stationary point), grows ×10 when the violation does not fall to a quarter, and is capped at
 //! [`AlOptions::rho_max`] (beyond it multiplier updates become noise). A final least-squares
@@ -38,9 +40,6 @@ pub struct AlOptions {
     pub second_order: bool,
     /// Largest Newton step `‖Δx‖∞` (keeps continuation on its branch).
     pub max_step: f64,
-    /// The penalty grows ×10 after an outer iteration that does not bring the violation below
-    /// this fraction of the previous one.
-    pub decrease: f64,
     /// With Newton inner steps, update the multipliers of the active rows by a Newton step on
     /// the dual function, `λ ← λ + (J ∇²Φ⁻¹ Jᵀ)⁻¹ c` (Bertsekas's second-order multiplier
     /// iteration), instead of `λ ← λ + ρc`: the violation then falls superlinearly instead of
@@ -60,7 +59,6 @@ impl Default for AlOptions {
             active_tol: 1e-7,
             second_order: true,
             max_step: f64::INFINITY,
-            decrease: 0.25,
             newton_multipliers: true,
         }
     }
@@ -199,6 +197,8 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut dual_ok = use_newton && opts.newton_multipliers;
     // The point and ∇²Φ of Newton's last Hessian.
     let mut last_hessian: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+    // The last outer iteration took a second-order multiplier step.
+    let mut dual_stepped = false;
     while outer < opts.max_outer {
         outer += 1;
         let out = if use_newton {
@@ -238,7 +238,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     grad_tol: inner_tol,
                     max_iter: opts.max_inner,
                     max_step: opts.max_step,
-                    min_iter: usize::from(opts.newton_multipliers && outer > 1),
+                    min_iter: usize::from(dual_stepped),
                 },
             )
         } else {
@@ -296,6 +296,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                 }
             }
         }
+        dual_stepped = dual_step.is_some();
         if let Some(l) = dual_step {
             lambda = l;
         }
@@ -315,7 +316,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             status = AlStatus::Converged;
             break;
         }
-        if viol > opts.decrease * viol_prev {
+        if viol > 0.25 * viol_prev {
             dual_ok = false;
             if rho >= opts.rho_max && viol > opts.feasibility_tol && outer > 5 {
                 status = AlStatus::Infeasible;

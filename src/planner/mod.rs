@@ -393,7 +393,6 @@ impl Planner {
             active_tol: 1e-7,
             second_order: self.options.optimiser == spec::Optimiser::Newton,
             max_step: f64::INFINITY,
-            decrease: 0.25,
             newton_multipliers: false,
         };
         let mut z = z0;
