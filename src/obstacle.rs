@@ -91,17 +91,13 @@ impl Obstacle {
         self.pose
     }
 
-    /// Projection of world point `pv` onto the surface, `None` for a half-space (analytic).
-    fn project(&self, pose: &Pose, pv: Vector) -> Option<parry3d_f64::query::PointProjection> {
-        Some(match &self.shape {
-            ObstacleShape::HalfSpace(_) => return None,
-            ObstacleShape::Cuboid(s) => s.project_point(pose, pv, false),
-            ObstacleShape::Ball(s) => s.project_point(pose, pv, false),
-            ObstacleShape::Capsule(s) => s.project_point(pose, pv, false),
-            ObstacleShape::Cylinder(s) => s.project_point(pose, pv, false),
-            ObstacleShape::ConvexHull(s) => s.project_point(pose, pv, false),
-            ObstacleShape::TriMesh(s) => s.project_point(pose, pv, false),
-        })
+    /// World point `pv` in the obstacle's frame.
+    fn to_local(&self, pv: Vector) -> Vector {
+        if self.rotated {
+            self.pose.inverse_transform_point(pv)
+        } else {
+            pv - self.pose.translation
+        }
     }
 
     /// Projection of the local point `pl` onto the surface, in the local frame (`None` for a
@@ -124,11 +120,7 @@ impl Obstacle {
         let pose = &self.pose;
         let pv = v3(p);
         // In the obstacle's frame: one transform in, the normal rotated out.
-        let pl = if self.rotated {
-            pose.inverse_transform_point(pv)
-        } else {
-            pv - pose.translation
-        };
+        let pl = self.to_local(pv);
         let Some(proj) = self.project_local(pl) else {
             let ObstacleShape::HalfSpace(n) = &self.shape else {
                 unreachable!()
@@ -170,12 +162,11 @@ impl Obstacle {
 
     /// Signed distance only (no normal), for the on-surface fallback.
     fn signed_distance_value(&self, p: [f64; 3]) -> f64 {
-        let pose = self.pose();
-        let pv = v3(p);
-        match self.project(&pose, pv) {
+        let pl = self.to_local(v3(p));
+        match self.project_local(pl) {
             None => self.signed_distance(p).0,
             Some(proj) => {
-                let d = (pv - proj.point).length();
+                let d = (pl - proj.point).length();
                 if proj.is_inside { -d } else { d }
             }
         }

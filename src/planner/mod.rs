@@ -304,7 +304,6 @@ impl Planner {
         // the previous shape and must stay on its branch of equilibria (unlimited steps let a
         // solve jump to another equilibrium on the mesh case).
         static_options.al.max_step = static_options.al.max_step.min(0.1);
-
         let start = end_shape(case, "start", &options.start, &static_options)?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
@@ -656,7 +655,6 @@ impl Planner {
                 .filter(|o| o.clearance < -tol)
                 .map(|o| o.k)
                 .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k));
-
             for kw in worst_k.collect::<Vec<_>>() {
                 // The grid's worst k and its grid neighbours, and the midpoints of the
                 // optimiser's interval holding it and of the intervals on either side: the
