@@ -1,6 +1,7 @@
 //! Finite-difference checks of every energy term's gradient and every constraint kind's
 //! Jacobian, on random coefficients, planar and 3D (the contract every constraint must pass).
 
+mod common;
 use dlo_planner::basis::Basis;
 use dlo_planner::constraints::*;
 use dlo_planner::energy::Objective;
@@ -426,32 +427,12 @@ fn static_hessian_matches_finite_differences() {
         let path = std::path::Path::new("planning_cases").join(name);
         let case = dlo_planner::case::load(&path).unwrap();
         let mut p = case.problem.clone();
-        let (n, m) = (p.n(), p.m());
+        let m = p.m();
         let mut rng = Lcg(7);
         let a: Vec<f64> = case.initial.iter().map(|v| v + 0.2 * rng.next()).collect();
         let y: Vec<f64> = (0..m).map(|_| rng.next()).collect();
-        let mut c = vec![0.0; m];
-        p.values(&a, &mut c);
-        let mut h = vec![0.0; n * n];
         assert!(p.has_hessian() && p.hessian_is_exact(&y));
-        p.hessian(&a, &y, &vec![0.0; m], &mut h);
-        let step = 1e-6;
-        let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
-        let scale = h.iter().fold(1e-8_f64, |s, v| s.max(v.abs()));
-        let mut worst: f64 = 0.0;
-        for j in 0..n {
-            let mut x = a.clone();
-            x[j] += step;
-            p.values(&x, &mut c);
-            p.gradient(&x, &y, &mut gp);
-            x[j] -= 2.0 * step;
-            p.values(&x, &mut c);
-            p.gradient(&x, &y, &mut gm);
-            for i in 0..n {
-                let fd = (gp[i] - gm[i]) / (2.0 * step);
-                worst = worst.max((fd - h[i * n + j]).abs() / scale);
-            }
-        }
+        let worst = common::hessian_fd_error(&mut p, &a, &y);
         assert!(worst < 1e-5, "{name}: Hessian relative error {worst:e}");
     }
 }

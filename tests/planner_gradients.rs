@@ -2,6 +2,7 @@
 //! energy, the equilibrium-tracking term and the sampled path constraints, all chained through
 //! the path parameterisation and the null space of the fixed conditions.
 
+mod common;
 use dlo_planner::case;
 use dlo_planner::optim::Nlp;
 use dlo_planner::planner::Planner;
@@ -150,28 +151,8 @@ fn check_hessian(name: &str, tracking: bool) {
     let (mut p, z) = setup(name, tracking);
     let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
-    let mut c = vec![0.0; m];
-    p.values(&z, &mut c);
-    let mut h = vec![0.0; n * n];
     assert!(p.has_hessian());
-    p.hessian(&z, &y, &vec![0.0; m], &mut h);
-    let step = 1e-6;
-    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
-    let scale = h.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
-    let mut worst: f64 = 0.0;
-    for j in 0..n {
-        let mut zp = z.clone();
-        zp[j] += step;
-        p.values(&zp, &mut c);
-        p.gradient(&zp, &y, &mut gp);
-        zp[j] -= 2.0 * step;
-        p.values(&zp, &mut c);
-        p.gradient(&zp, &y, &mut gm);
-        for i in 0..n {
-            let fd = (gp[i] - gm[i]) / (2.0 * step);
-            worst = worst.max((fd - h[i * n + j]).abs() / scale);
-        }
-    }
+    let worst = common::hessian_fd_error(&mut p, &z, &y);
     assert!(worst < 1e-5, "{name}: Hessian relative error {worst:e}");
     // Penalty part: two rows with weights s.
     let mut s = vec![0.0; m];
@@ -179,7 +160,10 @@ fn check_hessian(name: &str, tracking: bool) {
     for &r in &rows {
         s[r] = 2.0 + r as f64;
     }
+    let mut c = vec![0.0; m];
     p.values(&z, &mut c);
+    let mut h = vec![0.0; n * n];
+    p.hessian(&z, &y, &vec![0.0; m], &mut h);
     let mut h2 = vec![0.0; n * n];
     p.hessian(&z, &y, &s, &mut h2);
     let (_, jr) = dlo_planner::optim::augmented_lagrangian::jacobian_rows(&mut p, &z, &rows);

@@ -96,3 +96,31 @@ pub fn clamp(model: &Model, t: f64) -> Box<dyn Constraint> {
         vec![(Angle::Field(Field::Theta), 0.0)],
     ))
 }
+
+/// Largest difference between `p`'s Hessian `∇²f + Σ yᵢ∇²cᵢ` at `x` and central differences
+/// (step 1e-6) of its gradient, relative to the Hessian's largest entry.
+pub fn hessian_fd_error<P: dlo_planner::optim::Nlp>(p: &mut P, x: &[f64], y: &[f64]) -> f64 {
+    let (n, m) = (p.n(), p.m());
+    let mut c = vec![0.0; m];
+    p.values(x, &mut c);
+    let mut h = vec![0.0; n * n];
+    p.hessian(x, y, &vec![0.0; m], &mut h);
+    let step = 1e-6;
+    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+    let scale = h.iter().fold(1e-8_f64, |s, v| s.max(v.abs()));
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        let mut xs = x.to_vec();
+        xs[j] += step;
+        p.values(&xs, &mut c);
+        p.gradient(&xs, y, &mut gp);
+        xs[j] -= 2.0 * step;
+        p.values(&xs, &mut c);
+        p.gradient(&xs, y, &mut gm);
+        for i in 0..n {
+            let fd = (gp[i] - gm[i]) / (2.0 * step);
+            worst = worst.max((fd - h[i * n + j]).abs() / scale);
+        }
+    }
+    worst
+}
