@@ -84,7 +84,16 @@ impl Model {
         let spatial = lay.spatial;
         let mut t = EnergyTerms::default();
         let mut grad = grad;
-        for q in 0..self.nodes() {
+        if self.quadratic_energy {
+            self.quadratic_terms(a, &mut t, grad.as_deref_mut());
+        }
+        // The node sums below, unless the quadratic form has already given them.
+        let nodes = if self.quadratic_energy {
+            0
+        } else {
+            self.nodes()
+        };
+        for q in 0..nodes {
             let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
             let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
             let one = 1.0 + eps;
@@ -159,6 +168,28 @@ impl Model {
             }
         }
         t
+    }
+
+    /// Flexure and extension of a planar rod without gravity, `½ aᵀ K a` with the constant
+    /// Hessian `K` (its θ block is flexure, its ε block extension; the two do not couple), and
+    /// the gradient `K a` added to `grad`: the same sums as the node loop, in `n²` operations
+    /// instead of `nodes · n`.
+    fn quadratic_terms(&self, a: &[f64], t: &mut EnergyTerms, grad: Option<&mut [f64]>) {
+        let n = self.n();
+        let nb = self.nb();
+        let oe = self.layout.offset(Field::Eps);
+        let mut grad = grad;
+        for i in 0..n {
+            let kai = crate::basis::dot(&self.constant_hessian[i * n..(i + 1) * n], a);
+            if i < nb {
+                t.flexural += 0.5 * kai * a[i];
+            } else if oe.is_some_and(|o| i >= o && i < o + nb) {
+                t.extensional += 0.5 * kai * a[i];
+            }
+            if let Some(g) = grad.as_deref_mut() {
+                g[i] += kai;
+            }
+        }
     }
 
     /// Objective value and gradient (overwritten) at `a`; convenience for tests and solvers.

@@ -61,12 +61,12 @@ impl Model {
             let th = dot(at, e);
             shape.th[q] = th;
             shape.dth[q] = dot(at, de);
-            (shape.sth[q], shape.cth[q]) = th.sin_cos();
+            (shape.sth[q], shape.cth[q]) = crate::trig::sin_cos(th);
             if let Some(ap) = ap {
                 let ph = dot(ap, e);
                 shape.ph[q] = ph;
                 shape.dph[q] = dot(ap, de);
-                (shape.sph[q], shape.cph[q]) = ph.sin_cos();
+                (shape.sph[q], shape.cph[q]) = crate::trig::sin_cos(ph);
             } else {
                 shape.cph[q] = 1.0;
             }

@@ -35,5 +35,6 @@ pub mod quadrature;
 pub mod report;
 pub mod rod;
 pub mod statics;
+pub mod trig;
 
 pub use error::Error;

@@ -70,6 +70,8 @@ pub struct Model {
     /// The part of the energy Hessian that does not depend on the coefficients (flexure in θ',
     /// torsion in ψ', extension in ε), row-major `n×n`.
     pub(crate) constant_hessian: Vec<f64>,
+    /// The energy is the quadratic form `½ aᵀ K a` of `constant_hessian` (planar, no gravity).
+    pub(crate) quadratic_energy: bool,
 }
 
 impl Model {
@@ -119,8 +121,12 @@ impl Model {
             wg,
             gravity_total,
             constant_hessian: Vec::new(),
+            quadratic_energy: false,
         };
         model.constant_hessian = model.assemble_constant_hessian();
+        model.quadratic_energy = !model.layout.spatial
+            && model.gravity_total == 0.0
+            && model.wg.iter().all(|&w| w == 0.0);
         model
     }
 

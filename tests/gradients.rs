@@ -134,6 +134,106 @@ fn energy_gradient_matches_finite_differences() {
     }
 }
 
+/// A weightless planar rod's energy is a quadratic form in the coefficients (flexure in θ',
+/// extension in ε), evaluated as such: its terms against the model's own node sums
+/// (1e-12 relative) and an independent composite Simpson integration of `½∫ Rf θ'²` and
+/// `½∫ Re ε²` (20,000 intervals; 1e-8 relative, the 16 × 4-point Gauss rule's own error on
+/// these integrands is ≈ 2e-9), and its gradient against finite differences.
+#[test]
+fn weightless_planar_energy_is_its_quadratic_form() {
+    let mut rng = Lcg(5);
+    for (ext, free) in [(false, false), (true, false), (true, true)] {
+        let r = Rod {
+            weight: Profile::Constant(0.0),
+            ..rod(false, ext)
+        };
+        let layout = Layout {
+            basis: Basis::new(3),
+            spatial: false,
+            extensible: ext,
+            free_base: free,
+        };
+        let m = Model::new(
+            r.clone(),
+            layout,
+            Discretisation::default(),
+            [0.0; 3],
+            vec![],
+            &[],
+        );
+        let a = random_a(&m, &mut rng, 0.8);
+        let shape = m.evaluate(&a);
+        let terms = m.energy(&a, &shape, Objective::Potential, None);
+        let nb = layout.basis.len();
+        let th = &a[..nb];
+        let eps = layout.offset(Field::Eps).map(|o| &a[o..o + nb]);
+        let (rf, l) = (r.rf_ref(), r.length);
+        let intervals = 20_000;
+        let (mut flex, mut ext_e) = (0.0, 0.0);
+        let mut d = vec![0.0; nb];
+        for i in 0..=intervals {
+            let t = i as f64 / intervals as f64;
+            let w = if i == 0 || i == intervals {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            } / (3.0 * intervals as f64);
+            layout.basis.derivatives(t, &mut d);
+            let dth: f64 = th.iter().zip(&d).map(|(c, e)| c * e).sum();
+            flex += w * 0.5 * r.flexural.at(t) / rf * dth * dth;
+            if let Some(eps) = eps {
+                let e = layout.basis.eval(eps, t);
+                ext_e += w * 0.5 * r.extensional.unwrap().at(t) * l * l / rf * e * e;
+            }
+        }
+        let (mut flex_q, mut ext_q) = (0.0, 0.0);
+        for (q, (&t, &w)) in m.mesh.nodes.iter().zip(&m.mesh.weights).enumerate() {
+            flex_q += 0.5 * w * r.flexural.at(t) / rf * shape.dth[q] * shape.dth[q];
+            if ext {
+                let e = shape.eps[q];
+                ext_q += 0.5 * w * r.extensional.unwrap().at(t) * l * l / rf * e * e;
+            }
+        }
+        assert!(
+            (terms.flexural - flex_q).abs() <= 1e-12 * flex_q,
+            "flexure {} vs node sum {flex_q}",
+            terms.flexural
+        );
+        assert!(
+            (terms.extensional - ext_q).abs() <= 1e-12 * ext_q.max(1e-300),
+            "extension {} vs node sum {ext_q}",
+            terms.extensional
+        );
+        assert!(
+            (terms.flexural - flex).abs() <= 1e-8 * flex,
+            "flexure {} vs Simpson {flex}",
+            terms.flexural
+        );
+        assert!(
+            (terms.extensional - ext_e).abs() <= 1e-8 * ext_e.max(1e-300),
+            "extension {} vs Simpson {ext_e}",
+            terms.extensional
+        );
+        assert_eq!(terms.gravitational, 0.0);
+        let mut g = vec![0.0; m.n()];
+        let mut sh = Shape::default();
+        m.objective_and_gradient(&a, Objective::Potential, &mut sh, &mut g);
+        let mut f = |x: &[f64]| {
+            let mut s = Shape::default();
+            let mut gg = vec![0.0; m.n()];
+            m.objective_and_gradient(x, Objective::Potential, &mut s, &mut gg)
+        };
+        fd_check(
+            &mut f,
+            &a,
+            &g,
+            &format!("weightless planar ext={ext} free={free}"),
+        );
+    }
+}
+
 /// Each energy term separately, by switching the others off.
 #[test]
 fn each_energy_term_gradient_matches_finite_differences() {

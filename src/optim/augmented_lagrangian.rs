@@ -128,9 +128,14 @@ pub struct OuterIterate<'a> {
     pub x: &'a [f64],
 }
 
+/// Width (in the rows' own units, dimensionless lengths) of the band around an inequality's
+/// boundary where its penalty curvature enters `∇²Φ`.
+const BOUNDARY_BAND: f64 = 1e-9;
+
 /// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier estimates
 /// `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows whose
-/// penalty is active (`ρ`, else 0), which make the Gauss–Newton part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
+/// penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton part
+/// `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
 fn augment(
     f: f64,
     c: &[f64],
@@ -152,7 +157,16 @@ fn augment(
                 let t = (lam[i] + rho * c[i]).max(0.0);
                 phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
                 y[i] = t;
-                s[i] = if t > 0.0 { rho } else { 0.0 };
+                // The penalty's curvature also counts for a row that sits on its boundary to
+                // within rounding (`λ + ρc` in (−ρ·1e-9, 0]): there `Φ` has a kink in its
+                // second derivative, and a Hessian without the row lets a Newton step cross the
+                // boundary by far more than the quadratic penalty allows (the line search then
+                // fails at a contact the start shape already touches).
+                s[i] = if lam[i] + rho * c[i] > -rho * BOUNDARY_BAND {
+                    rho
+                } else {
+                    0.0
+                };
             }
         }
     }
