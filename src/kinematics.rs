@@ -2,7 +2,6 @@
 //! `(1+ε)ζ` (eq. 5), positions by cumulative quadrature (eq. 6), frames (eq. 1), and
 //! vector–Jacobian products `Σ_b v_b · ∂x(b)/∂a` computed in one backward pass.
 
-use crate::basis::dot;
 use crate::layout::Field;
 use crate::model::Model;
 
@@ -56,26 +55,30 @@ impl Model {
             }
             v.resize(nn, 0.0);
         }
-        for q in 0..nn {
-            let (e, de) = (self.e_at(q), self.de_at(q));
-            let th = dot(at, e);
-            shape.th[q] = th;
-            shape.dth[q] = dot(at, de);
-            (shape.sth[q], shape.cth[q]) = crate::trig::sin_cos(th);
-            if let Some(ap) = ap {
-                let ph = dot(ap, e);
-                shape.ph[q] = ph;
-                shape.dph[q] = dot(ap, de);
-                (shape.sph[q], shape.cph[q]) = crate::trig::sin_cos(ph);
-            } else {
-                shape.cph[q] = 1.0;
+        // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
+        let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            for (&ci, row) in c.iter().zip(m.chunks_exact(nn)) {
+                for (v, &r) in out.iter_mut().zip(row) {
+                    *v += ci * r;
+                }
             }
-            if let Some(aps) = aps {
-                shape.dps[q] = dot(aps, de);
-            }
-            if let Some(ae) = ae {
-                shape.eps[q] = dot(ae, e);
-            }
+        };
+        rows(at, &self.e_rows, &mut shape.th);
+        rows(at, &self.de_rows, &mut shape.dth);
+        crate::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
+        if let Some(ap) = ap {
+            rows(ap, &self.e_rows, &mut shape.ph);
+            rows(ap, &self.de_rows, &mut shape.dph);
+            crate::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
+        } else {
+            shape.cph.iter_mut().for_each(|v| *v = 1.0);
+        }
+        if let Some(aps) = aps {
+            rows(aps, &self.de_rows, &mut shape.dps);
+        }
+        if let Some(ae) = ae {
+            rows(ae, &self.e_rows, &mut shape.eps);
         }
         let base = self.base_position(a);
         shape.positions.clear();

@@ -57,6 +57,11 @@ pub struct Model {
     pub(crate) e: Vec<f64>,
     /// Basis derivatives `de/dt`, node-major.
     pub(crate) de: Vec<f64>,
+    /// Basis values, function-major (`nb × nodes`): a field at every node is a sum of `nb`
+    /// scaled rows, which vectorises.
+    pub(crate) e_rows: Vec<f64>,
+    /// Basis derivatives, function-major.
+    pub(crate) de_rows: Vec<f64>,
     /// `w · Rf(t)/Rf`.
     pub(crate) wf: Vec<f64>,
     /// `w · Rt(t)/Rf`.
@@ -104,6 +109,10 @@ impl Model {
             we[q] = w * rod.extensional.map_or(0.0, |p| p.at(t)) * l * l / rf_ref;
             wg[q] = w * rod.weight.integral_from(t) * l.powi(3) / rf_ref;
         }
+        let transpose = |m: &[f64]| -> Vec<f64> {
+            (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect()
+        };
+        let (e_rows, de_rows) = (transpose(&e), transpose(&de));
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
         let mut model = Model {
@@ -115,6 +124,8 @@ impl Model {
             load_boundary,
             e,
             de,
+            e_rows,
+            de_rows,
             wf,
             wt,
             we,

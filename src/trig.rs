@@ -38,22 +38,45 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if x.abs() >= 1e5 || !x.is_finite() {
         return x.sin_cos();
     }
+    reduced(x)
+}
+
+/// `s[i], c[i] = sin x[i], cos x[i]`: without branches when every argument is in range, so
+/// that the loop vectorises.
+pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
+    if x.iter().all(|v| v.abs() < 1e5) {
+        for ((&xi, si), ci) in x.iter().zip(s.iter_mut()).zip(c.iter_mut()) {
+            (*si, *ci) = reduced(xi);
+        }
+    } else {
+        for ((&xi, si), ci) in x.iter().zip(s.iter_mut()).zip(c.iter_mut()) {
+            (*si, *ci) = sin_cos(xi);
+        }
+    }
+}
+
+/// The kernel for `|x| < 10⁵`; the quadrant swaps and signs by bit operations.
+#[inline(always)]
+fn reduced(x: f64) -> (f64, f64) {
     let t = x * std::f64::consts::FRAC_2_PI + ROUND;
-    let quadrant = t.to_bits() & 3;
+    let quadrant = t.to_bits();
     let n = t - ROUND;
     let r = ((x - n * PIO2_1) - n * PIO2_2) - n * PIO2_3;
     let z = r * r;
     let s = r + z * r * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
     let hz = 0.5 * z;
     let w = 1.0 - hz;
-    let c =
-        w + (((1.0 - w) - hz) + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
-    match quadrant {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    let c = w + (((1.0 - w) - hz)
+        + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
+    // Quadrant q = n mod 4: odd q swaps sine and cosine; the sine is negated for q = 2, 3 and
+    // the cosine for q = 1, 2.
+    let swap = (quadrant & 1).wrapping_neg();
+    let (sb, cb) = (s.to_bits(), c.to_bits());
+    let sin = (sb & !swap) | (cb & swap);
+    let cos = (cb & !swap) | (sb & swap);
+    let sin_sign = (quadrant & 2) << 62;
+    let cos_sign = (quadrant.wrapping_add(1) & 2) << 62;
+    (f64::from_bits(sin ^ sin_sign), f64::from_bits(cos ^ cos_sign))
 }
 
 #[cfg(test)]
@@ -89,6 +112,21 @@ mod tests {
             worst = worst.max(es).max(ec);
         }
         assert!(worst <= 1.5, "worst error {worst} ulp");
+    }
+
+    #[test]
+    fn slices_match_single_calls() {
+        let x: Vec<f64> = (0..1000).map(|i| -31.0 + 0.0621 * i as f64).collect();
+        let (mut s, mut c) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        sin_cos_slice(&x, &mut s, &mut c);
+        for i in 0..x.len() {
+            assert_eq!((s[i], c[i]), sin_cos(x[i]));
+        }
+        let mut y = x.clone();
+        y[500] = 2e5;
+        sin_cos_slice(&y, &mut s, &mut c);
+        assert_eq!((s[500], c[500]), 2e5_f64.sin_cos());
+        assert_eq!((s[499], c[499]), sin_cos(y[499]));
     }
 
     #[test]
