@@ -109,9 +109,8 @@ impl Model {
             we[q] = w * rod.extensional.map_or(0.0, |p| p.at(t)) * l * l / rf_ref;
             wg[q] = w * rod.weight.integral_from(t) * l.powi(3) / rf_ref;
         }
-        let transpose = |m: &[f64]| -> Vec<f64> {
-            (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect()
-        };
+        let transpose =
+            |m: &[f64]| -> Vec<f64> { (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect() };
         let (e_rows, de_rows) = (transpose(&e), transpose(&de));
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();

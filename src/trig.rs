@@ -66,8 +66,8 @@ fn reduced(x: f64) -> (f64, f64) {
     let s = r + z * r * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
     let hz = 0.5 * z;
     let w = 1.0 - hz;
-    let c = w + (((1.0 - w) - hz)
-        + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
+    let c =
+        w + (((1.0 - w) - hz) + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
     // Quadrant q = n mod 4: odd q swaps sine and cosine; the sine is negated for q = 2, 3 and
     // the cosine for q = 1, 2.
     let swap = (quadrant & 1).wrapping_neg();
@@ -76,7 +76,10 @@ fn reduced(x: f64) -> (f64, f64) {
     let cos = (cb & !swap) | (sb & swap);
     let sin_sign = (quadrant & 2) << 62;
     let cos_sign = (quadrant.wrapping_add(1) & 2) << 62;
-    (f64::from_bits(sin ^ sin_sign), f64::from_bits(cos ^ cos_sign))
+    (
+        f64::from_bits(sin ^ sin_sign),
+        f64::from_bits(cos ^ cos_sign),
+    )
 }
 
 #[cfg(test)]

@@ -106,9 +106,28 @@ fn paper_replay_coincides() {
     assert!(r.replay.coincide);
 }
 
+/// The verdict is not one lucky start's: single starts reach several local minima, and only
+/// the lower ones coincide (README), so the case takes four. Four other starts (seeds 5–8
+/// instead of 1–4) reach a coinciding plan too.
+#[test]
+fn paper_replay_coincides_from_other_starts() {
+    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["plan"]["seed"] = serde_json::json!(5);
+    let c = case::parse(&v.to_string(), Path::new("paper_seed5.json")).unwrap();
+    let r = Planner::from_case(&c).unwrap().run(&mut Silent);
+    assert_eq!(r.status, PlanStatus::Planned);
+    assert!(
+        r.replay.coincide && r.replay.max_deviation_over_l <= 0.02,
+        "{}",
+        r.replay.max_deviation_over_l
+    );
+}
+
 /// With the paper's three path terms the replay follows the plan within 2 % of L up to
-/// k = 0.9 and departs by more in the last swing past the block's corner (measured 2.8 %; the
-/// README discusses it): the verdict is honest either way, so both bounds are asserted.
+/// k = 0.9; in the last swing past the block's corner it departs by up to 2.7 % from most of
+/// the local minima the optimiser reaches (the README discusses it): the verdict depends on
+/// the minimum, so both bounds are asserted.
 #[test]
 fn paper_three_terms_depart_only_in_the_last_swing() {
     let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
