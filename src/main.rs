@@ -253,6 +253,7 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
         kkt_residual: Some(kkt),
         stable: None,
         min_reduced_eigenvalue: None,
+        neutral_modes: None,
         end_pose: pose(p, &a, p.model.rod.length),
         points: c.report_points.iter().map(|&s| pose(p, &a, s)).collect(),
         coefficients: coefficients_json(p, &a),
@@ -295,6 +296,14 @@ fn print_report(r: &ShapeReport, json: bool) {
         Some(false) => ", UNSTABLE",
         None => "",
     });
+    if let Some(n @ 1..) = r.neutral_modes {
+        let _ = write!(
+            o,
+            " ({n} neutral mode{}: the second-order check cannot decide along {})",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "it" } else { "them" }
+        );
+    }
     let _ = writeln!(o);
     for re in &r.reactions {
         let _ = writeln!(

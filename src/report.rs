@@ -85,6 +85,8 @@ pub struct ShapeReport {
     pub stable: Option<bool>,
     /// Smallest reduced-Hessian eigenvalue (units of `Rf/L`).
     pub min_reduced_eigenvalue: Option<f64>,
+    /// Reduced-Hessian eigenvalues within the stability tolerance of zero.
+    pub neutral_modes: Option<usize>,
     /// Pose of the `s = L` frame.
     pub end_pose: PoseReport,
     /// Poses at the report points.
@@ -136,6 +138,7 @@ impl ShapeReport {
             kkt_residual: Some(sol.kkt_residual),
             stable: sol.stable,
             min_reduced_eigenvalue: sol.min_reduced_eigenvalue,
+            neutral_modes: sol.neutral_modes,
             end_pose: pose(p, &sol.a, p.model.rod.length),
             points: points.iter().map(|&s| pose(p, &sol.a, s)).collect(),
             coefficients: coefficients_json(p, &sol.a),

@@ -77,6 +77,10 @@ pub struct StaticSolution {
     pub stable: Option<bool>,
     /// Smallest eigenvalue of the reduced Hessian (dimensionless), if computed.
     pub min_reduced_eigenvalue: Option<f64>,
+    /// Reduced-Hessian eigenvalues within the stability tolerance of zero: directions along
+    /// which the second-order check cannot decide (e.g. a rotation the constraints leave free),
+    /// so a `stable` verdict holds only up to them.
+    pub neutral_modes: Option<usize>,
     /// Outer iterations of the multiplier method.
     pub outer_iterations: usize,
     /// Objective evaluations.
@@ -108,16 +112,18 @@ fn finish(
     out: crate::optim::AlOutcome,
     opts: &StaticOptions,
 ) -> StaticSolution {
-    let (stable, min_eig) = if opts.stability && out.status != AlStatus::NumericalFailure {
+    let (stable, min_eig, neutral) = if opts.stability && out.status != AlStatus::NumericalFailure {
         let ev = reduced_hessian_eigenvalues(p, &a, &out.lambda, 1e-8);
         match (ev.first(), ev.last()) {
             (Some(&lo), Some(&hi)) => {
-                (Some(lo > -opts.stability_tol * hi.abs().max(1.0)), Some(lo))
+                let tol = opts.stability_tol * hi.abs().max(1.0);
+                let neutral = ev.iter().filter(|v| v.abs() <= tol).count();
+                (Some(lo > -tol), Some(lo), Some(neutral))
             }
-            _ => (Some(true), None),
+            _ => (Some(true), None, Some(0)),
         }
     } else {
-        (None, None)
+        (None, None, None)
     };
     let mut c = vec![0.0; crate::optim::Nlp::m(p)];
     crate::optim::Nlp::values(p, &a, &mut c);
@@ -133,6 +139,7 @@ fn finish(
         reactions,
         stable,
         min_reduced_eigenvalue: min_eig,
+        neutral_modes: neutral,
         outer_iterations: out.outer_iterations,
         evaluations: out.evaluations,
         a,

@@ -108,3 +108,33 @@ fn planar_flexure_is_invariant_under_rotation_in_the_plane() {
     };
     assert!((f(&a) - f(&b)).abs() < 1e-12);
 }
+
+/// A constant added to ψ changes neither the energy (torsion sees ψ' only) nor any position, so
+/// where no condition fixes ψ the reduced Hessian has exactly one zero eigenvalue: the solve
+/// reports it as a neutral mode next to its `stable` verdict. Fixing ψ(0) removes it.
+#[test]
+fn a_free_twist_angle_is_reported_as_one_neutral_mode() {
+    let text = |psi: &str| {
+        format!(
+            r#"{{
+  "name": "neutral", "planar": false,
+  "rod": {{ "length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.7, "radius": 0.01 }},
+  "constraints": [
+    {{ "type": "orientation", "s": 0.0, "phi": 0.0, "theta": 0.4{psi} }},
+    {{ "type": "position", "s": 1.0, "x": 0.3, "y": 0.2, "z": 0.7 }}
+  ]
+}}"#
+        )
+    };
+    let mut neutral = Vec::new();
+    for psi in ["", r#", "psi": 0.0"#] {
+        let mut c =
+            dlo_planner::case::parse(&text(psi), std::path::Path::new("neutral.json")).unwrap();
+        let a0 = c.initial.clone();
+        let sol = dlo_planner::statics::solve_static(&mut c.problem, &a0, &c.options);
+        assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+        assert_eq!(sol.stable, Some(true));
+        neutral.push(sol.neutral_modes);
+    }
+    assert_eq!(neutral, [Some(1), Some(0)]);
+}

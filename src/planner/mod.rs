@@ -221,6 +221,7 @@ fn end_shape(
             reactions,
             stable: None,
             min_reduced_eigenvalue: None,
+            neutral_modes: None,
             outer_iterations: 0,
             evaluations: 1,
             a,
