@@ -196,26 +196,16 @@ fn weightless_planar_energy_is_its_quadratic_form() {
                 ext_q += 0.5 * w * r.extensional.unwrap().at(t) * l * l / rf * e * e;
             }
         }
-        assert!(
-            (terms.flexural - flex_q).abs() <= 1e-12 * flex_q,
-            "flexure {} vs node sum {flex_q}",
-            terms.flexural
-        );
-        assert!(
-            (terms.extensional - ext_q).abs() <= 1e-12 * ext_q.max(1e-300),
-            "extension {} vs node sum {ext_q}",
-            terms.extensional
-        );
-        assert!(
-            (terms.flexural - flex).abs() <= 1e-8 * flex,
-            "flexure {} vs Simpson {flex}",
-            terms.flexural
-        );
-        assert!(
-            (terms.extensional - ext_e).abs() <= 1e-8 * ext_e.max(1e-300),
-            "extension {} vs Simpson {ext_e}",
-            terms.extensional
-        );
+        let close = |got: f64, want: f64, rel: f64, what: &str| {
+            assert!(
+                (got - want).abs() <= rel * want.abs().max(1e-300),
+                "{what}: {got} vs {want}"
+            )
+        };
+        close(terms.flexural, flex_q, 1e-12, "flexure vs node sum");
+        close(terms.extensional, ext_q, 1e-12, "extension vs node sum");
+        close(terms.flexural, flex, 1e-8, "flexure vs Simpson");
+        close(terms.extensional, ext_e, 1e-8, "extension vs Simpson");
         assert_eq!(terms.gravitational, 0.0);
         let mut g = vec![0.0; m.n()];
         let mut sh = Shape::default();
