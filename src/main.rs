@@ -531,6 +531,19 @@ fn plan_summary(r: &PlanReport) -> String {
             .map_or("n/a".into(), |c| format!("{c:.4e}")),
         p.violation
     );
+    if p.starts.len() > 1 {
+        let _ = writeln!(
+            o,
+            "  starts: {}, chosen {}; sampled U_max {}",
+            p.starts.len(),
+            p.chosen_start,
+            p.starts
+                .iter()
+                .map(|s| format!("{:.4} ({:?})", s.sampled_u_max, s.status))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let rp = &p.replay;
     let _ = writeln!(
         o,

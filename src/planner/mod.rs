@@ -102,6 +102,8 @@ pub struct PlanResult {
     pub verification: Verification,
     /// Every start.
     pub starts: Vec<StartSummary>,
+    /// The start the plan comes from (the lowest sampled `U_max` among the feasible ones).
+    pub chosen_start: usize,
     /// Path vectors `cᵢ` (coefficient space).
     pub path: Vec<Vec<f64>>,
     /// The unknowns `z`.
@@ -737,6 +739,7 @@ impl Planner {
                     evaluations: r.evaluations,
                 })
                 .collect(),
+            chosen_start: best,
             path: path.c_vectors(&chosen.z),
             added_samples: added,
             z: chosen.z.clone(),
