@@ -80,8 +80,8 @@ fn gravity_lowers_the_clamped_arch_until_it_snaps_to_a_hanging_shape() {
     // §4.5 with the boundary conditions we use (the paper does not state its own): both ends
     // clamped along z (θ = 0), end distance 0.85 L, an upward arch as start. What holds: the
     // shape is symmetric at ρg = 0, its height falls as ρg grows, and the arch collapses into a
-    // hanging shape between ρg = 50 and 100. What does not: the paper's asymmetric minimum above
-    // ρg ≈ 100 (the symmetric shapes found here stay stable; see the README).
+    // hanging shape between ρg = 50 and 100 (at ρg ≈ 62.7, see the next test). What does not:
+    // the paper's asymmetric minimum above ρg ≈ 100 (see the README).
     let mut heights = Vec::new();
     for rho_g in [0.0, 20.0, 50.0, 100.0, 200.0] {
         let extra = format!(r#", "weight_per_length": {}"#, rho_g / 1e6);
@@ -112,6 +112,71 @@ fn gravity_lowers_the_clamped_arch_until_it_snaps_to_a_hanging_shape() {
         heights[3] < 0.0 && heights[4] < 0.0,
         "snapped to hanging: {heights:?}"
     );
+}
+
+/// Where the §4.5 arch stops being a minimum. Held at mid-span at the height `h` where the
+/// holding force vanishes (bisection on `x(L/2) = h`), the upward arch is a symmetric
+/// equilibrium of the free problem; released from it, it stays at ρg = 60 and falls into the
+/// hanging shape at ρg = 66: between the two it loses stability to an antisymmetric mode
+/// (measured ≈ 62.7), and no asymmetric upward equilibrium takes over — the paper's asymmetric
+/// shapes above ρg ≈ 100 have no counterpart here (README).
+#[test]
+fn gravity_arch_loses_stability_to_an_antisymmetric_mode_near_rho_g_63() {
+    let held = |rho_g: f64, h: f64| {
+        let text = clamped(0.85, &format!(r#", "weight_per_length": {}"#, rho_g / 1e6)).replace(
+            r#"{"type": "orientation", "s": 100.0, "theta": 0.0}]"#,
+            &format!(
+                r#"{{"type": "orientation", "s": 100.0, "theta": 0.0}},
+                   {{"type": "position", "s": 50.0, "x": {h}, "z": 42.5, "name": "mid"}}]"#
+            ),
+        );
+        let mut a0 = vec![0.0; 10];
+        a0[2] = 0.5;
+        let (c, sol) = solve_json(&text, Some(a0));
+        assert_eq!(sol.status, SolveStatus::Converged, "rho_g {rho_g}, h {h}");
+        let f = sol
+            .reactions
+            .iter()
+            .find(|r| r.constraint == "mid")
+            .expect("mid reaction")
+            .force;
+        (c, sol, f)
+    };
+    for (rho_g, stays) in [(60.0, true), (66.0, false)] {
+        let (mut lo, mut hi) = (21.8, 23.5);
+        for _ in 0..30 {
+            let mid = 0.5 * (lo + hi);
+            if held(rho_g, mid).2[0] < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let h = 0.5 * (lo + hi);
+        let (c, sol, f) = held(rho_g, h);
+        // A free equilibrium: the holding force vanishes (the rod weighs 6e-3 in all), and the
+        // shape is symmetric.
+        assert!(
+            f[0].abs() < 1e-8 && f[2].abs() < 1e-8,
+            "holding force {f:?}"
+        );
+        assert!(asymmetry(&c, &sol.a) < 1e-6);
+        let free = clamped(0.85, &format!(r#", "weight_per_length": {}"#, rho_g / 1e6));
+        let (c2, released) = solve_json(&free, Some(sol.a.clone()));
+        assert_eq!(released.status, SolveStatus::Converged);
+        let mid = profile(&c2, &released.a, 40)[20][0];
+        eprintln!(
+            "rho_g = {rho_g}: held at h = {h:.4} (U = {:.5}); released: mid-span height {mid:.3}, U = {:.5}",
+            sol.energy.potential(),
+            released.energy.potential()
+        );
+        if stays {
+            assert!((mid - h).abs() < 1e-3, "stays up: {mid} vs {h}");
+            assert_eq!(released.stable, Some(true));
+        } else {
+            assert!(mid < -20.0, "falls into the hanging shape: {mid}");
+        }
+    }
 }
 
 fn shipped(name: &str) -> String {
