@@ -93,11 +93,13 @@ fn replay_reproduces_start_and_goal() {
 }
 
 /// On the paper's example (with four path terms) the replay by the end pose coincides with the
-/// plan within the 2 % tolerance, every replayed shape stable and every solve converged.
+/// plan within the 2 % tolerance, every replayed shape stable (without neutral modes) and every
+/// solve converged.
 #[test]
 fn paper_replay_coincides() {
     let (_, r) = paper();
     assert!(r.replay.all_converged && r.replay.snaps.is_empty());
+    assert!(r.replay.steps.iter().all(|st| st.neutral_modes == Some(0)));
     assert!(
         r.replay.max_deviation_over_l <= 0.02,
         "{}",
@@ -362,6 +364,8 @@ fn mesh_case_3d_coincides() {
     assert_eq!(r.status, PlanStatus::Planned);
     assert!(r.min_clearance.unwrap() >= 0.0);
     assert!(r.replay.all_converged && r.replay.all_stable);
+    // Decided stability: no replayed shape has a neutral mode.
+    assert!(r.replay.steps.iter().all(|st| st.neutral_modes == Some(0)));
     assert!(
         r.replay.max_deviation_over_l <= 0.02,
         "{}",

@@ -33,6 +33,8 @@ pub struct ReplayStep {
     pub kkt_residual: f64,
     /// Stability of the replayed shape.
     pub stable: Option<bool>,
+    /// Neutral modes of its stability check (see [`crate::statics::StaticSolution`]).
+    pub neutral_modes: Option<usize>,
     /// Constraint violation of the solve (dimensionless).
     pub violation: f64,
 }
@@ -152,6 +154,7 @@ pub fn replay(
             status: st.sol.status,
             kkt_residual: st.sol.kkt_residual,
             stable: st.sol.stable,
+            neutral_modes: st.sol.neutral_modes,
             violation: st.sol.max_violation,
         });
         let clearance = super::clearance(base, &st.positions);
