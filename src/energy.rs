@@ -84,15 +84,12 @@ impl Model {
         let spatial = lay.spatial;
         let mut t = EnergyTerms::default();
         let mut grad = grad;
-        if self.quadratic_energy {
+        let quadratic = !self.energy_roots.is_empty();
+        if quadratic {
             self.quadratic_terms(a, &mut t, grad.as_deref_mut());
         }
         // The node sums below, unless the quadratic form has already given them.
-        let nodes = if self.quadratic_energy {
-            0
-        } else {
-            self.nodes()
-        };
+        let nodes = if quadratic { 0 } else { self.nodes() };
         for q in 0..nodes {
             let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
             let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
@@ -171,23 +168,23 @@ impl Model {
     }
 
     /// Flexure and extension of a planar rod without gravity, `½ aᵀ K a` with the constant
-    /// Hessian `K` (its θ block is flexure, its ε block extension; the two do not couple), and
-    /// the gradient `K a` added to `grad`: the same sums as the node loop, in `n²` operations
-    /// instead of `nodes · n`.
+    /// Hessian `K`, as the sum of squares `½ Σ_r (R_r · a)²` of its square-root rows, and the
+    /// gradient `K a = Σ_r (R_r · a) R_r` added to `grad`: the node sums' value in `n²`
+    /// operations instead of `nodes · n`.
     fn quadratic_terms(&self, a: &[f64], t: &mut EnergyTerms, grad: Option<&mut [f64]>) {
-        let n = self.n();
-        let nb = self.nb();
-        let oe = self.layout.offset(Field::Eps);
         let mut grad = grad;
-        for i in 0..n {
-            let kai = crate::basis::dot(&self.constant_hessian[i * n..(i + 1) * n], a);
-            if i < nb {
-                t.flexural += 0.5 * kai * a[i];
-            } else if oe.is_some_and(|o| i >= o && i < o + nb) {
-                t.extensional += 0.5 * kai * a[i];
+        for r in &self.energy_roots {
+            let ab = &a[r.offset..r.offset + r.row.len()];
+            let v = crate::basis::dot(&r.row, ab);
+            if r.flexural {
+                t.flexural += 0.5 * v * v;
+            } else {
+                t.extensional += 0.5 * v * v;
             }
             if let Some(g) = grad.as_deref_mut() {
-                g[i] += kai;
+                for (gi, ri) in g[r.offset..r.offset + r.row.len()].iter_mut().zip(&r.row) {
+                    *gi += v * ri;
+                }
             }
         }
     }

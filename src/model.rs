@@ -6,7 +6,7 @@
 //! material functions are then `Rf(s)/Rf`, `Rt(s)/Rf` (ρt), `Re(s) L²/Rf` (ρe) and
 //! `D(s) L³/Rf` (ρg).
 
-use crate::layout::Layout;
+use crate::layout::{Field, Layout};
 use crate::quadrature::Mesh;
 use crate::rod::Rod;
 
@@ -75,8 +75,23 @@ pub struct Model {
     /// The part of the energy Hessian that does not depend on the coefficients (flexure in θ',
     /// torsion in ψ', extension in ε), row-major `n×n`.
     pub(crate) constant_hessian: Vec<f64>,
-    /// The energy is the quadratic form `½ aᵀ K a` of `constant_hessian` (planar, no gravity).
-    pub(crate) quadratic_energy: bool,
+    /// For a planar rod without gravity, whose energy is the quadratic form `½ aᵀ K a` of
+    /// `constant_hessian`: `K` as a sum of squares `Σ_r (R_r · a)²` (empty otherwise).
+    pub(crate) energy_roots: Vec<EnergyRoot>,
+}
+
+/// One square-root row of the constant energy Hessian: `√λ v` for an eigenpair `(λ, v)` of its
+/// flexure (θ) or extension (ε) block. A sum of squares keeps the rounding of the node sums it
+/// replaces; `aᵀ(Ka)` does not where large coefficients cancel (a split basis), and its noise
+/// stalled the grasp solves' line searches.
+#[derive(Clone, Debug)]
+pub(crate) struct EnergyRoot {
+    /// Offset of the block's coefficients.
+    pub(crate) offset: usize,
+    /// Flexure (θ block) rather than extension (ε block).
+    pub(crate) flexural: bool,
+    /// `√λ v`, one entry per basis function.
+    pub(crate) row: Vec<f64>,
 }
 
 impl Model {
@@ -131,13 +146,42 @@ impl Model {
             wg,
             gravity_total,
             constant_hessian: Vec::new(),
-            quadratic_energy: false,
+            energy_roots: Vec::new(),
         };
         model.constant_hessian = model.assemble_constant_hessian();
-        model.quadratic_energy = !model.layout.spatial
-            && model.gravity_total == 0.0
-            && model.wg.iter().all(|&w| w == 0.0);
+        if !model.layout.spatial && model.gravity_total == 0.0 && model.wg.iter().all(|&w| w == 0.0)
+        {
+            model.energy_roots = model.constant_hessian_roots();
+        }
         model
+    }
+
+    /// The square-root rows of the constant Hessian's flexure and extension blocks.
+    fn constant_hessian_roots(&self) -> Vec<EnergyRoot> {
+        let (n, nb) = (self.n(), self.nb());
+        let blocks = [
+            Some((0, true)),
+            self.layout.offset(Field::Eps).map(|o| (o, false)),
+        ];
+        let mut roots = Vec::new();
+        for (offset, flexural) in blocks.into_iter().flatten() {
+            let k = nalgebra::DMatrix::from_fn(nb, nb, |i, j| {
+                self.constant_hessian[(offset + i) * n + offset + j]
+            });
+            let eig = k.symmetric_eigen();
+            for (j, &lambda) in eig.eigenvalues.iter().enumerate() {
+                if lambda > 0.0 {
+                    let s = lambda.sqrt();
+                    let row = eig.eigenvectors.column(j).iter().map(|v| s * v).collect();
+                    roots.push(EnergyRoot {
+                        offset,
+                        flexural,
+                        row,
+                    });
+                }
+            }
+        }
+        roots
     }
 
     /// Number of unknowns.
