@@ -128,7 +128,7 @@ fn paper_replay_coincides_from_other_starts() {
 }
 
 /// With the paper's three path terms the replay follows the plan within 2 % of L up to
-/// k = 0.9; in the last swing past the block's corner it departs by up to 2.7 % from most of
+/// k = 0.9; in the last swing past the block's corner it departs by up to 2.6 % from most of
 /// the local minima the optimiser reaches (the README discusses it): the verdict depends on
 /// the minimum, so both bounds are asserted.
 #[test]
