@@ -206,3 +206,20 @@ fn split_shape_is_continuous_with_a_shear_jump() {
         qr - ql
     );
 }
+
+/// Fig. 15's trend on the full default grid (9 points × 9 directions × 10 μ) of grasp (a) at
+/// l = 0.8L: F_mub grows with μ at every step (measured: by 6 % or more). A curve that goes flat
+/// here came from solves that stalled rather than from a contact lost; such a regression (the
+/// energy evaluated as `aᵀ(Ka)`) flattened it from μ = 0.5.
+#[test]
+fn full_margin_curve_grows_at_every_friction_step() {
+    let m = grasp_a(0.80, "{}").margin(&|_, _| {}).unwrap();
+    assert_eq!(m.f_mub.len(), 10);
+    for w in m.f_mub.windows(2) {
+        assert!(
+            w[1] > 1.01 * w[0],
+            "F_mub not growing with μ: {:?}",
+            m.f_mub
+        );
+    }
+}
