@@ -114,15 +114,8 @@ impl Model {
             if spatial {
                 g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
             }
-            if g_th == 0.0 {
-                // Planar, no gravity: θ enters through θ' only.
-                for (gi, dei) in g[..nb].iter_mut().zip(de) {
-                    *gi += g_dth * dei;
-                }
-            } else {
-                for i in 0..nb {
-                    g[i] += g_th * e[i] + g_dth * de[i];
-                }
+            for i in 0..nb {
+                g[i] += g_th * e[i] + g_dth * de[i];
             }
             if let (Some(op), Some(ops)) = (op, ops) {
                 let g_ph = -wg * one * st * sp;

@@ -37,7 +37,7 @@ impl Model {
         let ap = lay.field(a, Field::Phi);
         let aps = lay.field(a, Field::Psi);
         let ae = lay.field(a, Field::Eps);
-        // Fields the loop below overwrites only need the right length; the others are zero.
+        // Fields written below only need the right length; the others are zero.
         for (v, present) in [
             (&mut shape.th, true),
             (&mut shape.dth, true),
