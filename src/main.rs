@@ -520,8 +520,8 @@ fn plan_summary(r: &PlanReport) -> String {
     );
     let _ = writeln!(
         o,
-        "  U_max {:.6e} at k = {:.3}   straight path U_max {:.6e}   start {:.6e}  goal {:.6e}",
-        p.u_max, p.k_at_u_max, p.u_max_straight, r.start_energy, r.goal_energy
+        "  U_max {:.6e} at k = {:.3} (optimiser's samples {:.6e})   straight path U_max {:.6e}   start {:.6e}  goal {:.6e}",
+        p.u_max, p.k_at_u_max, p.sampled_u_max, p.u_max_straight, r.start_energy, r.goal_energy
     );
     let _ = writeln!(
         o,

@@ -156,6 +156,35 @@ fn paper_three_terms_depart_only_in_the_last_swing() {
     );
 }
 
+/// The optimiser minimises the energy at its own samples of `k`; on 21 samples the path's true
+/// maximum (on the 201-point verification grid) can fall between them. Refinement adds the
+/// peak's `k` to the samples until the true `U_max` is within the 1 % tolerance of the sampled
+/// one; without it (tolerance 1e9) the same start keeps a plan whose peak the samples miss by
+/// more than that, at a higher true `U_max`.
+#[test]
+fn energy_peaks_between_samples_are_refined() {
+    let run = |gap: f64| {
+        let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["plan"]["k_samples"] = serde_json::json!(21);
+        v["plan"]["starts"] = serde_json::json!(1);
+        v["plan"]["seed"] = serde_json::json!(2);
+        v["plan"]["energy_gap_tolerance"] = serde_json::json!(gap);
+        let c = case::parse(&v.to_string(), Path::new("paper_k21.json")).unwrap();
+        Planner::from_case(&c).unwrap().run(&mut Silent)
+    };
+    let off = run(1e9);
+    let on = run(0.01);
+    assert_eq!(off.status, PlanStatus::Planned);
+    assert_eq!(on.status, PlanStatus::Planned);
+    let gap = |r: &dlo_planner::planner::PlanResult| (r.u_max - r.sampled_u_max) / r.u_max;
+    assert!(gap(&off) > 0.01, "without refinement: {}", gap(&off));
+    assert!(gap(&on) <= 0.01, "with refinement: {}", gap(&on));
+    assert!(on.u_max < off.u_max, "{} vs {}", on.u_max, off.u_max);
+    // The refined samples include the peak the unrefined plan missed.
+    assert!(on.added_samples.len() > off.added_samples.len());
+}
+
 fn plan_text(start: &str, goal: &str, obstacles: &str) -> String {
     format!(
         r#"{{
@@ -302,6 +331,18 @@ fn bad_planning_inputs_name_the_field() {
             plan_text(r#"{ "x": 0.3, "z": 0.9 }"#, r#"{ "x": 0.3, "z": 0.9 }"#, "")
                 .replace(r#""k_samples": 21"#, r#""k_samples": 21, "bogus": 1"#),
             "plan",
+        ),
+        (
+            plan_text(
+                r#"{ "x": 0.3, "z": 0.9 }"#,
+                r#"{ "x": -0.3, "z": 0.9 }"#,
+                "",
+            )
+            .replace(
+                r#""k_samples": 21"#,
+                r#""k_samples": 21, "energy_gap_tolerance": -0.1"#,
+            ),
+            "plan.energy_gap_tolerance",
         ),
     ];
     for (text, field) in cases {

@@ -90,6 +90,9 @@ pub struct PlanResult {
     pub u_max: f64,
     /// `k` where it occurs.
     pub k_at_u_max: f64,
+    /// The largest energy on the optimiser's own `k` samples for the plan (case units): the
+    /// value it minimised, which `u_max` exceeds where a peak falls between samples.
+    pub sampled_u_max: f64,
     /// `U_max` of the straight-line path `c = 0` (case units).
     pub u_max_straight: f64,
     /// Smallest obstacle clearance on the verification grid, optimal path (case units).
@@ -111,7 +114,7 @@ pub struct PlanResult {
     pub z: Vec<f64>,
     /// Feasibility replay.
     pub replay: Replay,
-    /// `k` samples added where the verification grid found tunnelling.
+    /// `k` samples added where the verification grid found tunnelling or a missed energy peak.
     pub added_samples: Vec<f64>,
     /// Seconds spent planning (optimise + verify) and replaying.
     pub timing_s: Timing,
@@ -642,26 +645,40 @@ impl Planner {
         let mut chosen = runs[best].clone();
         observer.phase("verify");
         let mut ver = check(&chosen.z);
-        // Tunnelling between samples: add the verification grid's worst k (and its neighbours
-        // on that grid) to the optimiser's samples and optimise again from the current path.
+        // Tunnelling between samples, or an energy peak between them: add the verification
+        // grid's worst k (and its neighbours on that grid) to the optimiser's samples and
+        // optimise again from the current path. The best verified path is kept (collision-free
+        // first, then the lower true U_max).
         let tol = 1e-6 * model.rod.length;
         let mut ks = uniform.clone();
         let mut added = Vec::new();
         let h = 1.0 / (self.options.verify_k - 1) as f64;
+        let gap = self.options.energy_gap;
+        let missed_peak = |r: &StartRun, v: &Verification| {
+            v.u_max - r.sampled_max > gap * r.sampled_max.abs().max(v.u_max.abs())
+        };
+        let better = |a: &Verification, b: &Verification| {
+            (a.collision_free(tol), -a.u_max) > (b.collision_free(tol), -b.u_max)
+        };
+        let mut kept: Option<(StartRun, Verification)> = None;
         for _ in 0..self.options.sample_refinements {
-            if ver.collision_free(tol) {
+            let tunnels = !ver.collision_free(tol);
+            let peak = missed_peak(&chosen, &ver);
+            if !tunnels && !peak {
                 break;
             }
-            let worst_k = ver
+            let worst_k: Vec<f64> = ver
                 .obstacles
                 .iter()
                 .filter(|o| o.clearance < -tol)
                 .map(|o| o.k)
-                .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k));
-            for kw in worst_k.collect::<Vec<_>>() {
+                .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k))
+                .chain(peak.then_some(ver.k_at_u_max))
+                .collect();
+            for kw in worst_k {
                 // The grid's worst k and its grid neighbours, and the midpoints of the
                 // optimiser's interval holding it and of the intervals on either side: the
-                // sample spacing halves where the path tunnels.
+                // sample spacing halves where the path tunnels or peaks.
                 let mut cand = vec![kw - h, kw, kw + h];
                 let i = ks
                     .iter()
@@ -679,6 +696,9 @@ impl Planner {
                 }
             }
             ks.sort_by(f64::total_cmp);
+            if kept.as_ref().is_none_or(|(_, kv)| better(&ver, kv)) {
+                kept = Some((chosen.clone(), ver.clone()));
+            }
             observer.phase("optimise");
             // Warm: only the sharpest stage again.
             let last = self.options.sharpness.len() - 1;
@@ -692,6 +712,15 @@ impl Planner {
             };
             observer.phase("verify");
             ver = check(&chosen.z);
+        }
+        if let Some((kr, kv)) = kept
+            && better(&kv, &ver)
+        {
+            chosen = StartRun {
+                evaluations: chosen.evaluations,
+                ..kr
+            };
+            ver = kv;
         }
         let chosen = &chosen;
         let t_plan = t0.elapsed().as_secs_f64();
@@ -724,6 +753,7 @@ impl Planner {
             optimiser: chosen.status,
             u_max: ver.u_max,
             k_at_u_max: ver.k_at_u_max,
+            sampled_u_max: chosen.sampled_max,
             u_max_straight: straight.u_max,
             min_clearance: ver.min_clearance,
             min_clearance_straight: straight.min_clearance,

@@ -50,9 +50,14 @@ pub struct PlanSpec {
     /// Size (radians) of the extra starts' perturbations.
     #[serde(default = "d_spread")]
     pub start_spread: f64,
-    /// Rounds of adding samples where the verification grid finds tunnelling.
+    /// Rounds of adding samples where the verification grid finds tunnelling or an energy peak
+    /// the samples missed.
     #[serde(default = "d_sample_ref")]
     pub sample_refinements: usize,
+    /// Relative excess of the verification grid's `U_max` over the optimiser's sampled maximum
+    /// beyond which the peak's `k` is added to the samples.
+    #[serde(default = "d_energy_gap")]
+    pub energy_gap_tolerance: f64,
     /// Replay steps in `k` (refined where the replayed shape jumps).
     #[serde(default = "d_steps")]
     pub replay_steps: usize,
@@ -119,6 +124,9 @@ fn d_spread() -> f64 {
 }
 fn d_sample_ref() -> usize {
     4
+}
+fn d_energy_gap() -> f64 {
+    0.01
 }
 fn d_steps() -> usize {
     40
@@ -201,8 +209,10 @@ pub struct PlanOptions {
     pub seed: u64,
     /// Perturbation of extra starts (radians).
     pub spread: f64,
-    /// Rounds of sample refinement against tunnelling.
+    /// Rounds of sample refinement against tunnelling and missed energy peaks.
     pub sample_refinements: usize,
+    /// Relative energy excess that triggers a refinement.
+    pub energy_gap: f64,
     /// Replay steps.
     pub replay_steps: usize,
     /// Bisections per replay step.
@@ -334,6 +344,9 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         v.positive(&format!("plan.sharpness[{i}]"), *b)?;
     }
     v.finite("plan.start_spread", spec.start_spread)?;
+    if v.finite("plan.energy_gap_tolerance", spec.energy_gap_tolerance)? < 0.0 {
+        return Err(v.err("plan.energy_gap_tolerance", "must be non-negative"));
+    }
     v.positive("plan.coincide_tolerance", spec.coincide_tolerance)?;
     // Fixed conditions may not sit on the controlled end.
     for (i, c) in case.file.constraints.iter().enumerate() {
@@ -365,6 +378,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         seed: spec.seed,
         spread: spec.start_spread,
         sample_refinements: spec.sample_refinements,
+        energy_gap: spec.energy_gap_tolerance,
         replay_steps: spec.replay_steps,
         refinements: spec.replay_refinements,
         tolerance: spec.coincide_tolerance,
