@@ -21,6 +21,27 @@ fn paper() -> &'static (Planner, dlo_planner::planner::PlanResult) {
     })
 }
 
+/// The paper's case with `plan` fields replaced, planned and replayed.
+fn paper_with(fields: serde_json::Value) -> dlo_planner::planner::PlanResult {
+    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for (key, val) in fields.as_object().unwrap() {
+        v["plan"][key] = val.clone();
+    }
+    let c = case::parse(&v.to_string(), Path::new("paper_variant.json")).unwrap();
+    Planner::from_case(&c).unwrap().run(&mut Silent)
+}
+
+/// The replay's largest deviation (units of L) at `k ≤ k_max`.
+fn deviation_up_to(r: &dlo_planner::planner::PlanResult, k_max: f64) -> f64 {
+    r.replay
+        .steps
+        .iter()
+        .filter(|s| s.k <= k_max)
+        .map(|s| s.deviation)
+        .fold(0.0, f64::max)
+}
+
 /// The straight-line path `c = 0` goes through the block; the plan clears it on a grid of
 /// 201 × 257 points the optimiser never saw.
 #[test]
@@ -108,13 +129,7 @@ fn paper_replay_coincides() {
     assert!(r.replay.coincide);
     // Up to the last swing (k ≤ 0.95) within 1 % of L, the level the independent
     // implementation reached outside its middle swing (measured 0.62 %, at k = 0.525).
-    let before_last_swing = r
-        .replay
-        .steps
-        .iter()
-        .filter(|s| s.k <= 0.95)
-        .map(|s| s.deviation)
-        .fold(0.0, f64::max);
+    let before_last_swing = deviation_up_to(r, 0.95);
     assert!(before_last_swing < 0.01, "{before_last_swing}");
 }
 
@@ -124,11 +139,7 @@ fn paper_replay_coincides() {
 /// coinciding plan too.
 #[test]
 fn paper_replay_coincides_from_other_starts() {
-    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    v["plan"]["seed"] = serde_json::json!(5);
-    let c = case::parse(&v.to_string(), Path::new("paper_seed5.json")).unwrap();
-    let r = Planner::from_case(&c).unwrap().run(&mut Silent);
+    let r = paper_with(serde_json::json!({ "seed": 5 }));
     assert_eq!(r.status, PlanStatus::Planned);
     assert!(
         r.replay.coincide && r.replay.max_deviation_over_l <= 0.02,
@@ -143,21 +154,9 @@ fn paper_replay_coincides_from_other_starts() {
 /// the minimum, so both bounds are asserted.
 #[test]
 fn paper_three_terms_depart_only_in_the_last_swing() {
-    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    v["plan"]["path_terms"] = serde_json::json!(3);
-    v["plan"]["safety_margin"] = serde_json::json!(0.01);
-    let c = case::parse(&v.to_string(), Path::new("paper_m3.json")).unwrap();
-    let p = Planner::from_case(&c).unwrap();
-    let r = p.run(&mut Silent);
+    let r = paper_with(serde_json::json!({ "path_terms": 3, "safety_margin": 0.01 }));
     assert_eq!(r.status, PlanStatus::Planned);
-    let away: f64 = r
-        .replay
-        .steps
-        .iter()
-        .filter(|s| s.k <= 0.9)
-        .map(|s| s.deviation)
-        .fold(0.0, f64::max);
+    let away = deviation_up_to(&r, 0.9);
     assert!(away < 0.02, "max deviation for k ≤ 0.9: {away}");
     assert!(
         r.replay.max_deviation_over_l < 0.05,
@@ -174,14 +173,9 @@ fn paper_three_terms_depart_only_in_the_last_swing() {
 #[test]
 fn energy_peaks_between_samples_are_refined() {
     let run = |gap: f64| {
-        let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
-        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        v["plan"]["k_samples"] = serde_json::json!(21);
-        v["plan"]["starts"] = serde_json::json!(1);
-        v["plan"]["seed"] = serde_json::json!(2);
-        v["plan"]["energy_gap_tolerance"] = serde_json::json!(gap);
-        let c = case::parse(&v.to_string(), Path::new("paper_k21.json")).unwrap();
-        Planner::from_case(&c).unwrap().run(&mut Silent)
+        paper_with(serde_json::json!({
+            "k_samples": 21, "starts": 1, "seed": 2, "energy_gap_tolerance": gap
+        }))
     };
     let off = run(1e9);
     let on = run(0.01);
