@@ -400,22 +400,53 @@ fn multi_start_reports_every_start_and_keeps_the_best() {
     assert_eq!(chosen.sampled_u_max, best);
 }
 
-/// A 3D case with torsion and a triangle-mesh obstacle: collision-free on the verification grid,
-/// and the replay by the end pose coincides with the plan within the 2 % tolerance.
-#[test]
-fn mesh_case_3d_coincides() {
-    let c = case::load(Path::new("planning_cases/plan_cable_past_mesh.json")).unwrap();
+/// Plans a shipped 3D case and asserts what every one of them must show: planned, collision-free
+/// on the verification grid, every replayed shape converged and stable with no neutral mode,
+/// and the replay within the 2 % tolerance of the plan.
+fn shipped_3d_case_coincides(name: &str) -> dlo_planner::planner::PlanResult {
+    let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
     let p = Planner::from_case(&c).unwrap();
     let r = p.run(&mut Silent);
-    assert_eq!(r.status, PlanStatus::Planned);
-    assert!(r.min_clearance.unwrap() >= 0.0);
-    assert!(r.replay.all_converged && r.replay.all_stable);
+    assert_eq!(r.status, PlanStatus::Planned, "{name}");
+    assert!(
+        r.min_clearance.unwrap() >= 0.0,
+        "{name}: {:?}",
+        r.min_clearance
+    );
+    assert!(r.replay.all_converged && r.replay.all_stable, "{name}");
     // Decided stability: no replayed shape has a neutral mode.
-    assert!(r.replay.steps.iter().all(|st| st.neutral_modes == Some(0)));
+    assert!(
+        r.replay.steps.iter().all(|st| st.neutral_modes == Some(0)),
+        "{name}"
+    );
     assert!(
         r.replay.max_deviation_over_l <= 0.02,
-        "{}",
+        "{name}: {}",
         r.replay.max_deviation_over_l
     );
-    assert!(r.replay.coincide);
+    assert!(r.replay.coincide, "{name}");
+    r
+}
+
+/// A 3D case with torsion and a triangle-mesh obstacle.
+#[test]
+fn mesh_case_3d_coincides() {
+    shipped_3d_case_coincides("plan_cable_past_mesh.json");
+}
+
+/// A cable swung over a bar.
+#[test]
+fn bar_case_3d_coincides() {
+    shipped_3d_case_coincides("plan_cable_over_bar.json");
+}
+
+/// A cable routed around a pillar its straight-line path runs through (by more than 0.1 L).
+#[test]
+fn pillar_case_3d_coincides() {
+    let r = shipped_3d_case_coincides("plan_cable_around_pillar.json");
+    assert!(
+        r.min_clearance_straight.unwrap() < -0.1,
+        "{:?}",
+        r.min_clearance_straight
+    );
 }
