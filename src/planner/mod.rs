@@ -156,9 +156,7 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Box<dyn Const
     let mut blocks: Vec<Box<dyn Constraint>> = Vec::new();
     for con in &p.constraints {
         let any = con.as_any();
-        if let Some(oc) = any.downcast_ref::<OrientationConstraint>()
-            && oc.rows.iter().all(|(a, _)| matches!(a, Angle::Field(_)))
-        {
+        if let Some(oc) = any.downcast_ref::<OrientationConstraint>() {
             for &(ang, _) in &oc.rows {
                 let mut row = vec![0.0; n];
                 for &(f, w) in ang.terms() {
