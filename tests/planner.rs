@@ -461,7 +461,8 @@ fn bar_case(phi_plus_psi: bool) -> case::Case {
         v["constraints"][0] =
             serde_json::json!({"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0});
     }
-    let nb = 2 + 2 * 3;
+    // The Ritz basis 1, s, and `basis_pairs` sine–cosine pairs.
+    let nb = 2 + 2 * v["discretisation"]["basis_pairs"].as_u64().unwrap() as usize;
     let mut phi = vec![0.0; nb];
     let mut psi = vec![0.0; nb];
     phi[0] = std::f64::consts::PI;
