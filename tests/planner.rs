@@ -21,14 +21,21 @@ fn paper() -> &'static (Planner, dlo_planner::planner::PlanResult) {
     })
 }
 
+/// The shipped case `name` with its JSON changed by `edit`.
+fn shipped_variant(name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> case::Case {
+    let text = std::fs::read_to_string(Path::new("planning_cases").join(name)).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut v);
+    case::parse(&v.to_string(), &Path::new("variant").join(name)).unwrap()
+}
+
 /// The paper's case with `plan` fields replaced, planned and replayed.
 fn paper_with(fields: serde_json::Value) -> dlo_planner::planner::PlanResult {
-    let text = std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    for (key, val) in fields.as_object().unwrap() {
-        v["plan"][key] = val.clone();
-    }
-    let c = case::parse(&v.to_string(), Path::new("paper_variant.json")).unwrap();
+    let c = shipped_variant("plan_paper_planar.json", |v| {
+        for (key, val) in fields.as_object().unwrap() {
+            v["plan"][key] = val.clone();
+        }
+    });
     Planner::from_case(&c).unwrap().run(&mut Silent)
 }
 
@@ -455,20 +462,20 @@ fn pillar_case_3d_coincides() {
 /// fixes, φ(0) + ψ(0) = 0 with θ(0) = 0, and the goal solve started from φ ≡ π, ψ ≡ −π (the
 /// start shape's mirror image).
 fn bar_case(phi_plus_psi: bool) -> case::Case {
-    let text = std::fs::read_to_string("planning_cases/plan_cable_over_bar.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    if phi_plus_psi {
-        v["constraints"][0] =
-            serde_json::json!({"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0});
-    }
-    // The Ritz basis 1, s, and `basis_pairs` sine–cosine pairs.
-    let nb = 2 + 2 * v["discretisation"]["basis_pairs"].as_u64().unwrap() as usize;
-    let mut phi = vec![0.0; nb];
-    let mut psi = vec![0.0; nb];
-    phi[0] = std::f64::consts::PI;
-    psi[0] = -std::f64::consts::PI;
-    v["plan"]["goal"]["shape"] = serde_json::json!({"phi": phi, "psi": psi});
-    case::parse(&v.to_string(), Path::new("bar_variant.json")).unwrap()
+    shipped_variant("plan_cable_over_bar.json", |v| {
+        if phi_plus_psi {
+            v["constraints"][0] = serde_json::json!(
+                {"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}
+            );
+        }
+        // The Ritz basis 1, s, and `basis_pairs` sine–cosine pairs.
+        let nb = 2 + 2 * v["discretisation"]["basis_pairs"].as_u64().unwrap() as usize;
+        let mut phi = vec![0.0; nb];
+        let mut psi = vec![0.0; nb];
+        phi[0] = std::f64::consts::PI;
+        psi[0] = -std::f64::consts::PI;
+        v["plan"]["goal"]["shape"] = serde_json::json!({"phi": phi, "psi": psi});
+    })
 }
 
 /// Start and goal of the bar case are mirror images (x → −x), so their equilibria hold the same
