@@ -3,31 +3,27 @@
 
 mod common;
 
-use dlo_planner::case;
 use dlo_planner::grasp::Grasp;
 use dlo_planner::optim::Nlp;
 use std::f64::consts::FRAC_1_SQRT_2 as H;
-use std::path::Path;
 
 /// Grasp (a) with the fingers `l` apart (l/L given).
 fn grasp_a(ratio: f64, extra: &str) -> Grasp {
-    let text = std::fs::read_to_string("planning_cases/grasp_a_080.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    v["constraints"][1]["z"]["max"] = serde_json::json!(100.0 * ratio);
-    if !extra.is_empty() {
-        v["grasp"] = serde_json::from_str(extra).unwrap();
-    }
-    let c = case::parse(&v.to_string(), Path::new("grasp_a.json")).unwrap();
+    let c = common::shipped_variant("grasp_a_080.json", |v| {
+        v["constraints"][1]["z"]["max"] = serde_json::json!(100.0 * ratio);
+        if !extra.is_empty() {
+            v["grasp"] = serde_json::from_str(extra).unwrap();
+        }
+    });
     Grasp::from_case(&c).unwrap()
 }
 
 fn grasp_b(extra: &str) -> Grasp {
-    let text = std::fs::read_to_string("planning_cases/grasp_b_pinch.json").unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    if !extra.is_empty() {
-        v["grasp"] = serde_json::from_str(extra).unwrap();
-    }
-    let c = case::parse(&v.to_string(), Path::new("grasp_b.json")).unwrap();
+    let c = common::shipped_variant("grasp_b_pinch.json", |v| {
+        if !extra.is_empty() {
+            v["grasp"] = serde_json::from_str(extra).unwrap();
+        }
+    });
     Grasp::from_case(&c).unwrap()
 }
 

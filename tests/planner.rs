@@ -3,6 +3,9 @@
 //! paths, the replay's agreement with the plan where it holds, and a negative verdict where
 //! one end cannot suffice.
 
+mod common;
+
+use common::shipped_variant;
 use dlo_planner::case;
 use dlo_planner::path::DeformationPath;
 use dlo_planner::planner::observer::Silent;
@@ -19,14 +22,6 @@ fn paper() -> &'static (Planner, dlo_planner::planner::PlanResult) {
         let r = p.run(&mut Silent);
         (p, r)
     })
-}
-
-/// The shipped case `name` with its JSON changed by `edit`.
-fn shipped_variant(name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> case::Case {
-    let text = std::fs::read_to_string(Path::new("planning_cases").join(name)).unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    edit(&mut v);
-    case::parse(&v.to_string(), &Path::new("variant").join(name)).unwrap()
 }
 
 /// The paper's case with `plan` fields replaced, planned and replayed.

@@ -124,3 +124,15 @@ pub fn hessian_fd_error<P: dlo_planner::optim::Nlp>(p: &mut P, x: &[f64], y: &[f
     }
     worst
 }
+
+/// The shipped case `name` (in `planning_cases/`) with its JSON changed by `edit`.
+pub fn shipped_variant(
+    name: &str,
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> dlo_planner::case::Case {
+    let path = std::path::Path::new("planning_cases").join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut v);
+    dlo_planner::case::parse(&v.to_string(), &std::path::Path::new("variant").join(name)).unwrap()
+}
