@@ -11,11 +11,13 @@ use std::path::Path;
 
 /// The planning problem of case `name` on 9 samples with test weights, a point `z` off the
 /// straight path, and (with `tracking`) targets: the sampled shapes of another path.
-fn setup(name: &str, tracking: bool) -> (MinimaxProblem, Vec<f64>) {
+/// With `swept`, the swept-clearance rows between consecutive samples follow the sampled rows.
+fn setup_with(name: &str, tracking: bool, swept: bool) -> (MinimaxProblem, Vec<f64>) {
     let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
     let pl = Planner::from_case(&c).unwrap();
     let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
     let mut p = pl.minimax_problem_at(ks);
+    p.set_swept(swept);
     p.beta = 3.0;
     p.mean_weight = 0.7;
     let (n, m) = (p.n(), p.m());
@@ -36,7 +38,14 @@ fn setup(name: &str, tracking: bool) -> (MinimaxProblem, Vec<f64>) {
 }
 
 fn check(name: &str, tracking: bool) {
-    let (mut p, z) = setup(name, tracking);
+    check_with(name, tracking, false);
+}
+
+fn check_with(name: &str, tracking: bool, swept: bool) {
+    let (mut p, z) = setup_with(name, tracking, swept);
+    if swept {
+        assert!(p.m() > p.sample_rows(), "{name}: no swept rows");
+    }
     let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
     let mut c = vec![0.0; m];
@@ -148,15 +157,25 @@ fn verification_finds_a_rod_crossing_itself() {
 /// obstacle distance's own curvature), and its penalty part `Σ sᵢ∇cᵢ∇cᵢᵀ` against
 /// gradient-differenced constraint rows.
 fn check_hessian(name: &str, tracking: bool) {
-    let (mut p, z) = setup(name, tracking);
+    check_hessian_with(name, tracking, false);
+}
+
+fn check_hessian_with(name: &str, tracking: bool, swept: bool) {
+    let (mut p, z) = setup_with(name, tracking, swept);
     let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
     assert!(p.has_hessian());
     let worst = common::hessian_fd_error(&mut p, &z, &y);
     assert!(worst < 1e-5, "{name}: Hessian relative error {worst:e}");
-    // Penalty part: two rows with weights s.
+    // Penalty part: two rows with weights s (with swept rows: the last sample's and the last
+    // pair's row at the free end).
     let mut s = vec![0.0; m];
-    let rows = [m / 3, m / 2];
+    let ns = p.sample_rows();
+    let rows = if swept {
+        [ns - 1, m - 1]
+    } else {
+        [m / 3, m / 2]
+    };
     for &r in &rows {
         s[r] = 2.0 + r as f64;
     }
@@ -167,6 +186,12 @@ fn check_hessian(name: &str, tracking: bool) {
     let mut h2 = vec![0.0; n * n];
     p.hessian(&z, &y, &s, &mut h2);
     let (_, jr) = dlo_planner::optim::augmented_lagrangian::jacobian_rows(&mut p, &z, &rows);
+    for (r, g) in rows.iter().zip(&jr) {
+        assert!(
+            g.iter().any(|v| v.abs() > 1e-3),
+            "{name}: row {r} has no gradient"
+        );
+    }
     let scale2 = h2.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
     let mut worst2: f64 = 0.0;
     for i in 0..n {
@@ -189,4 +214,14 @@ fn planar_minimax_hessian_matches_finite_differences() {
 #[test]
 fn spatial_minimax_hessian_matches_finite_differences() {
     check_hessian("plan_cable_around_pillar.json", true);
+}
+
+/// The swept-clearance rows (chord between consecutive samples kept clear, see
+/// `dlo_planner::planner::swept`): gradient and Hessian against differences, planar and 3D.
+#[test]
+fn swept_clearance_rows_match_finite_differences() {
+    check_with("plan_paper_planar.json", false, true);
+    check_with("plan_cable_around_pillar.json", true, true);
+    check_hessian_with("plan_paper_planar.json", true, true);
+    check_hessian_with("plan_cable_around_pillar.json", true, true);
 }

@@ -19,6 +19,7 @@ use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::{Nlp, Sense};
 use crate::path::DeformationPath;
+use crate::planner::swept::Swept;
 
 /// The minimax path problem.
 #[derive(Debug)]
@@ -41,6 +42,9 @@ pub struct MinimaxProblem {
     pub track_weight: f64,
     /// Tracking targets: boundary positions (dimensionless) per sample, when set.
     pub targets: Option<Vec<Vec<[f64; 3]>>>,
+    /// Swept-clearance rows between consecutive interior samples, when on
+    /// ([`MinimaxProblem::set_swept`]).
+    swept: Option<Swept>,
     interior: Vec<usize>,
     offsets: Vec<usize>,
     senses: Vec<Sense>,
@@ -91,6 +95,7 @@ impl MinimaxProblem {
             objective,
             track_weight: 0.0,
             targets: None,
+            swept: None,
             interior,
             offsets,
             senses,
@@ -108,6 +113,27 @@ impl MinimaxProblem {
     /// Rows per interior sample.
     pub fn rows_per_sample(&self) -> usize {
         *self.offsets.last().unwrap()
+    }
+
+    /// Adds (or removes) the swept-clearance rows ([`crate::planner::swept`]) between
+    /// consecutive interior samples, after the per-sample rows.
+    pub fn set_swept(&mut self, on: bool) {
+        let per_sample = self.interior.len() * self.rows_per_sample();
+        self.senses.truncate(per_sample);
+        self.swept = if on {
+            Swept::new(&self.blocks, self.interior.len())
+        } else {
+            None
+        };
+        if let Some(sw) = &self.swept {
+            self.senses
+                .extend(std::iter::repeat_n(Sense::LessEq, sw.rows()));
+        }
+    }
+
+    /// Number of per-sample rows (the swept rows follow them).
+    pub fn sample_rows(&self) -> usize {
+        self.interior.len() * self.rows_per_sample()
     }
 
     /// Sampled energies at the last evaluated point (dimensionless).
@@ -196,6 +222,11 @@ impl Nlp for MinimaxProblem {
                 row += per;
             }
         }
+        if let Some(sw) = &self.swept {
+            let shapes: Vec<&Shape> = self.interior.iter().map(|&j| &self.shapes[j]).collect();
+            let (rows, swept) = c.split_at_mut(row);
+            sw.values(rows, per, &self.offsets, &shapes, swept);
+        }
         let s = smoothed_max(&self.u, self.beta, &mut self.weights);
         let mean = self.u.iter().sum::<f64>() / self.u.len() as f64;
         s + self.mean_weight * mean + self.tracking()
@@ -206,16 +237,30 @@ impl Nlp for MinimaxProblem {
         let per = self.rows_per_sample();
         let nk = self.ks.len() as f64;
         let mut row = 0;
+        let n_sample_rows = self.sample_rows();
+        let mut yeff = vec![0.0; per];
+        let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&j| &self.shapes[j]).collect();
         for (j, &k) in self.ks.iter().enumerate() {
             let wj = self.weights[j] + self.mean_weight / nk;
             for (ga, gu) in self.ga.iter_mut().zip(&self.gu[j]) {
                 *ga = wj * gu;
             }
             if k > 0.0 && k < 1.0 {
-                let yj = &y[row..row + per];
+                yeff.copy_from_slice(&y[row..row + per]);
+                self.adj.clear();
+                let swept_any = self.swept.as_ref().is_some_and(|sw| {
+                    sw.add_sample_weights(
+                        row / per.max(1),
+                        &y[n_sample_rows..],
+                        &self.offsets,
+                        &interior_shapes,
+                        &mut yeff,
+                        &mut self.adj,
+                    )
+                });
+                let yj = &yeff;
                 let tracked = self.targets.is_some() && self.track_weight > 0.0;
-                if tracked || yj.iter().any(|v| *v != 0.0) {
-                    self.adj.clear();
+                if tracked || swept_any || yj.iter().any(|v| *v != 0.0) {
                     for (b, blk) in self.blocks.iter().enumerate() {
                         let w = &yj[self.offsets[b]..self.offsets[b + 1]];
                         if w.iter().any(|v| *v != 0.0) {
@@ -276,8 +321,20 @@ impl Nlp for MinimaxProblem {
             let (model, shape) = (&self.model, &self.shapes[j]);
             model.add_energy_hessian(shape, self.objective, wj, ha);
             let (blocks, offsets, aj) = (&self.blocks, &self.offsets, &self.a[j]);
-            let yj = &y[row..row + per];
-            add_weighted_curvature(blocks, offsets, model, aj, shape, yj, &mut self.adj, ha);
+            let mut yj = y[row..row + per].to_vec();
+            // The swept rows' share of this sample's obstacle rows, and their chord terms.
+            let mut chord = Adjoint::new(model);
+            if let Some(sw) = &self.swept {
+                let shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
+                let ys = &y[self.interior.len() * per..];
+                sw.add_sample_weights(row / per, ys, offsets, &shapes, &mut yj, &mut chord);
+            }
+            add_weighted_curvature(blocks, offsets, model, aj, shape, &yj, &mut self.adj, ha);
+            for (p, c) in self.adj.pos.iter_mut().zip(&chord.pos) {
+                for (pv, cv) in p.iter_mut().zip(c) {
+                    *pv += cv;
+                }
+            }
             if let (true, Some(t)) = (tracked, &self.targets) {
                 let tj = &t[j];
                 let wt = self.track_weight / tj.len() as f64;
@@ -292,6 +349,23 @@ impl Nlp for MinimaxProblem {
             add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut self.adj, ha);
             self.path.add_chain_hessian(ha, k, 1.0, h);
             row += per;
+        }
+        if let Some(sw) = &self.swept {
+            let ns = self.sample_rows();
+            let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
+            let a: Vec<&[f64]> = self.interior.iter().map(|&i| &self.a[i][..]).collect();
+            let shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
+            sw.add_coupling_hessian(
+                &self.model,
+                &self.path,
+                &self.blocks,
+                &kin,
+                &a,
+                &shapes,
+                &y[ns..],
+                &s[ns..],
+                h,
+            );
         }
         for (j, g) in gz.iter().enumerate() {
             add_rank_one(h, self.beta * self.weights[j], g);

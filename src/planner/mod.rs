@@ -9,6 +9,7 @@ pub mod minimax;
 pub mod observer;
 pub mod replay;
 pub mod spec;
+pub mod swept;
 pub mod verify;
 
 use crate::case::Case;
@@ -357,6 +358,7 @@ impl Planner {
             self.base.objective,
         );
         p.mean_weight = self.options.mean_weight;
+        p.set_swept(self.options.swept);
         p
     }
 

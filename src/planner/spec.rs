@@ -70,6 +70,10 @@ pub struct PlanSpec {
     /// Inner minimiser of the path optimisation's multiplier method.
     #[serde(default)]
     pub optimiser: Optimiser,
+    /// Keep the chord between consecutive samples' positions of every obstacle sample point
+    /// clear (see [`crate::planner::swept`]).
+    #[serde(default = "d_swept")]
+    pub swept_clearance: bool,
 }
 
 /// Inner minimiser of the path optimisation's sharpness stages (see the README for what each
@@ -83,6 +87,10 @@ pub enum Optimiser {
     /// Damped Newton with the analytic Hessian: it settles in other local minima, whose shapes
     /// lie farther from the equilibria.
     Newton,
+}
+
+fn d_swept() -> bool {
+    false
 }
 
 fn d_terms() -> usize {
@@ -221,6 +229,8 @@ pub struct PlanOptions {
     pub tolerance: f64,
     /// Inner minimiser of the path optimisation.
     pub optimiser: Optimiser,
+    /// Swept-clearance rows between consecutive samples.
+    pub swept: bool,
 }
 
 /// Reads and validates the case's `plan` section.
@@ -383,5 +393,6 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         refinements: spec.replay_refinements,
         tolerance: spec.coincide_tolerance,
         optimiser: spec.optimiser,
+        swept: spec.swept_clearance,
     })
 }
