@@ -65,7 +65,7 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("3D cases");
     g.sample_size(10);
     for name in [
-        "plan_cable_over_bar",
+        "plan_cable_under_bar",
         "plan_cable_around_pillar",
         "plan_cable_past_mesh",
     ] {

@@ -436,10 +436,38 @@ fn mesh_case_3d_coincides() {
     shipped_3d_case_coincides("plan_cable_past_mesh.json");
 }
 
-/// A cable swung over a bar.
+/// A cable swung under a bar its straight-line path runs through: the bar, not the end shapes,
+/// sets the plan's U_max (more than 1.5 times the end energies, at an interior k).
 #[test]
 fn bar_case_3d_coincides() {
-    shipped_3d_case_coincides("plan_cable_over_bar.json");
+    let r = shipped_3d_case_coincides("plan_cable_under_bar.json");
+    assert!(
+        r.min_clearance_straight.unwrap() < -0.05,
+        "{:?}",
+        r.min_clearance_straight
+    );
+    let c = case::load(&Path::new("planning_cases").join("plan_cable_under_bar.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let ends = p.start.energy.potential().max(p.goal.energy.potential());
+    assert!(r.u_max > 1.5 * ends, "U_max {} vs ends {ends}", r.u_max);
+    assert!(r.k_at_u_max > 0.1 && r.k_at_u_max < 0.9, "{}", r.k_at_u_max);
+    // The clamp is the base frame, θ(0) = 0 and φ(0) + ψ(0) = 0: the planner eliminates the
+    // second row as a linear condition on the path terms, so it holds at every k.
+    let path = p.path();
+    let model = &p.base.model;
+    let offset = |f| model.layout.offset(f).unwrap();
+    let (op, os) = (
+        offset(dlo_planner::layout::Field::Phi),
+        offset(dlo_planner::layout::Field::Psi),
+    );
+    let nb = model.layout.nb();
+    let mut a = vec![0.0; path.n()];
+    for i in 0..=20 {
+        let k = i as f64 / 20.0;
+        path.shape_at(&r.z, k, &mut a);
+        let at0 = |o: usize| model.layout.basis.eval(&a[o..o + nb], 0.0);
+        assert!((at0(op) + at0(os)).abs() < 1e-9, "k = {k}");
+    }
 }
 
 /// A cable routed around a pillar its straight-line path runs through (by more than 0.1 L).
@@ -451,25 +479,34 @@ fn pillar_case_3d_coincides() {
         "{:?}",
         r.min_clearance_straight
     );
+    // The swept rows leave no crossing for refinement to chase.
+    assert!(r.added_samples.is_empty(), "{:?}", r.added_samples);
 }
 
-/// The bar case, its clamp given either as φ(0) = ψ(0) = 0 (as shipped) or as the frame it
-/// fixes, φ(0) + ψ(0) = 0 with θ(0) = 0, and the goal solve started from φ ≡ π, ψ ≡ −π (the
-/// start shape's mirror image).
+/// Without the swept-clearance rows the pillar case's optimiser moves the cable through the
+/// pillar between two samples, and each refinement round only moves the crossing into another
+/// gap: after every round the verification grid still finds it inside the pillar.
+#[test]
+fn pillar_case_tunnels_without_swept_clearance() {
+    let c = shipped_variant("plan_cable_around_pillar.json", |v| {
+        v["plan"]["swept_clearance"] = serde_json::json!(false);
+    });
+    let r = Planner::from_case(&c).unwrap().run(&mut Silent);
+    assert_eq!(r.status, PlanStatus::Collision);
+    assert!(r.min_clearance.unwrap() < -0.01, "{:?}", r.min_clearance);
+    assert!(!r.added_samples.is_empty());
+}
+
+/// The bar case with its clamp given either as the base frame (θ(0) = 0, φ(0) + ψ(0) = 0, as
+/// shipped) or as separate rows φ(0) = ψ(0) = 0 with θ(0) = 0; the goal solve starts from
+/// φ ≡ π, ψ ≡ −π (the start shape's mirror image) either way.
 fn bar_case(phi_plus_psi: bool) -> case::Case {
-    shipped_variant("plan_cable_over_bar.json", |v| {
-        if phi_plus_psi {
-            v["constraints"][0] = serde_json::json!(
-                {"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}
-            );
-        }
-        // The Ritz basis 1, s, and `basis_pairs` sine–cosine pairs.
-        let nb = 2 + 2 * v["discretisation"]["basis_pairs"].as_u64().unwrap() as usize;
-        let mut phi = vec![0.0; nb];
-        let mut psi = vec![0.0; nb];
-        phi[0] = std::f64::consts::PI;
-        psi[0] = -std::f64::consts::PI;
-        v["plan"]["goal"]["shape"] = serde_json::json!({"phi": phi, "psi": psi});
+    shipped_variant("plan_cable_under_bar.json", |v| {
+        v["constraints"][0] = if phi_plus_psi {
+            serde_json::json!({"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0})
+        } else {
+            serde_json::json!({"type": "orientation", "s": 0.0, "phi": 0.0, "theta": 0.0, "psi": 0.0})
+        };
     })
 }
 
@@ -477,9 +514,7 @@ fn bar_case(phi_plus_psi: bool) -> case::Case {
 /// energy — when the clamp fixes only what it physically fixes. Where θ(0) = 0 the frame at
 /// the base is `Rz(φ + ψ)`; prescribing φ(0) = 0 and ψ(0) = 0 separately also fixes φ(0), the
 /// direction in which the rod starts to bend, to the x–z plane, and the mirror shape, which
-/// bends the other way (φ = π), pays for turning φ near the base. With `phi_plus_psi` the
-/// planner eliminates the clamp row as a linear condition, keeps it at every k, and the plan
-/// coincides with its replay.
+/// bends the other way (φ = π), pays for turning φ near the base.
 #[test]
 fn clamp_by_phi_plus_psi_gives_mirror_images_equal_energy() {
     let separate = Planner::from_case(&bar_case(false)).unwrap();
@@ -487,8 +522,9 @@ fn clamp_by_phi_plus_psi_gives_mirror_images_equal_energy() {
         separate.start.energy.potential(),
         separate.goal.energy.potential(),
     );
-    // Separate φ(0), ψ(0) rows: the mirror goal costs more than 10 % above the start.
-    assert!(g0 > 1.1 * s0, "start {s0}, goal {g0}");
+    // Separate φ(0), ψ(0) rows: the mirror goal costs more than five times the start (measured
+    // 2.461 against 0.3256).
+    assert!(g0 > 5.0 * s0, "start {s0}, goal {g0}");
 
     let frame = Planner::from_case(&bar_case(true)).unwrap();
     let (s1, g1) = (
@@ -496,33 +532,6 @@ fn clamp_by_phi_plus_psi_gives_mirror_images_equal_energy() {
         frame.goal.energy.potential(),
     );
     assert!((s1 - g1).abs() <= 1e-6 * s1, "start {s1}, goal {g1}");
-    // One condition fewer: the start's minimum can only fall (the twisted start bends slightly
-    // out of the x–z plane at the base: 3.26712 instead of 3.26747).
+    // One condition fewer: the start's minimum can only fall.
     assert!(s1 <= s0 * (1.0 + 1e-9), "{s1} vs {s0}");
-
-    let r = frame.run(&mut Silent);
-    assert_eq!(r.status, PlanStatus::Planned);
-    assert!(r.min_clearance.unwrap() >= 0.0);
-    let path = frame.path();
-    let model = &frame.base.model;
-    let (op, os) = (
-        model
-            .layout
-            .offset(dlo_planner::layout::Field::Phi)
-            .unwrap(),
-        model
-            .layout
-            .offset(dlo_planner::layout::Field::Psi)
-            .unwrap(),
-    );
-    let nb = model.layout.nb();
-    let mut a = vec![0.0; path.n()];
-    for i in 0..=20 {
-        let k = i as f64 / 20.0;
-        path.shape_at(&r.z, k, &mut a);
-        let at0 = |o: usize| model.layout.basis.eval(&a[o..o + nb], 0.0);
-        assert!((at0(op) + at0(os)).abs() < 1e-9, "k = {k}");
-    }
-    assert!(r.replay.all_converged && r.replay.all_stable);
-    assert!(r.replay.coincide, "{}", r.replay.max_deviation_over_l);
 }

@@ -261,7 +261,8 @@ mod tests {
             let q = [0.1 + 0.8 * rnd(), -0.2 + 0.8 * rnd(), 0.4 + 0.8 * rnd()];
             let (dp, _) = ob.signed_distance(p);
             let (dq, _) = ob.signed_distance(q);
-            let len = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
+            let len =
+                ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
             let bound = 0.5 * (dp + dq - len);
             if bound <= 0.0 {
                 continue;
