@@ -233,7 +233,6 @@ impl Swept {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::obstacle::{Obstacle, ObstacleShape};
     use parry3d_f64::shape::Cuboid;
 
