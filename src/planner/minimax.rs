@@ -307,6 +307,7 @@ impl Nlp for MinimaxProblem {
         let mut gz = vec![vec![0.0; nv]; self.ks.len()];
         let mut gbar = vec![0.0; nv];
         let mut row = 0;
+        let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
         for (j, &k) in self.ks.iter().enumerate() {
             if !(k > 0.0 && k < 1.0) {
                 continue;
@@ -325,9 +326,15 @@ impl Nlp for MinimaxProblem {
             // The swept rows' share of this sample's obstacle rows, and their chord terms.
             let mut chord = Adjoint::new(model);
             if let Some(sw) = &self.swept {
-                let shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
                 let ys = &y[self.interior.len() * per..];
-                sw.add_sample_weights(row / per, ys, offsets, &shapes, &mut yj, &mut chord);
+                sw.add_sample_weights(
+                    row / per,
+                    ys,
+                    offsets,
+                    &interior_shapes,
+                    &mut yj,
+                    &mut chord,
+                );
             }
             add_weighted_curvature(blocks, offsets, model, aj, shape, &yj, &mut self.adj, ha);
             for (p, c) in self.adj.pos.iter_mut().zip(&chord.pos) {
@@ -354,14 +361,13 @@ impl Nlp for MinimaxProblem {
             let ns = self.sample_rows();
             let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
             let a: Vec<&[f64]> = self.interior.iter().map(|&i| &self.a[i][..]).collect();
-            let shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
             sw.add_coupling_hessian(
                 &self.model,
                 &self.path,
                 &self.blocks,
                 &kin,
                 &a,
-                &shapes,
+                &interior_shapes,
                 &y[ns..],
                 &s[ns..],
                 h,
