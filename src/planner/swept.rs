@@ -10,9 +10,11 @@
 //!
 //! with `c_i = (r + margin)/L − d(x_i(b))/L` the obstacle row of sample `i`, keeps the straight
 //! chord between the two samples' positions of `b` clear by the required clearance. It needs no
-//! distance query of its own, implies both samples' rows (`d` is 1-Lipschitz), and stops the
+//! distance query of its own, implies both samples' rows (`d` is 1-Lipschitz; up to `δ/2` with
+//! the smoothing below), and stops the
 //! optimiser from moving a point across a thin obstacle between two samples. The chord is not the
-//! path's exact motion, which curves in `k`: the verification grid still checks it. `|Δ|` is
+//! path's exact motion, which curves in `k`, and the first and last intervals, next to the fixed
+//! end shapes (which carry no rows), have no swept row: the verification grid checks both. `|Δ|` is
 //! smoothed as `√(|Δ|² + δ²) − δ` with `δ = 1e-4` (units of `L`), so rows stay differentiable
 //! where a point does not move (the clamped base).
 
