@@ -118,7 +118,7 @@ impl MinimaxProblem {
     /// Adds (or removes) the swept-clearance rows ([`crate::planner::swept`]) between
     /// consecutive interior samples, after the per-sample rows.
     pub fn set_swept(&mut self, on: bool) {
-        let per_sample = self.interior.len() * self.rows_per_sample();
+        let per_sample = self.sample_rows();
         self.senses.truncate(per_sample);
         self.swept = if on {
             Swept::new(&self.blocks, self.interior.len())
@@ -249,14 +249,9 @@ impl Nlp for MinimaxProblem {
                 yeff.copy_from_slice(&y[row..row + per]);
                 self.adj.clear();
                 let swept_any = self.swept.as_ref().is_some_and(|sw| {
-                    sw.add_sample_weights(
-                        row / per.max(1),
-                        &y[n_sample_rows..],
-                        &self.offsets,
-                        &interior_shapes,
-                        &mut yeff,
-                        &mut self.adj,
-                    )
+                    let (i, ys) = (row / per, &y[n_sample_rows..]);
+                    sw.add_chord_cotangents(i, ys, &interior_shapes, &mut self.adj);
+                    sw.add_sample_weights(i, ys, &self.offsets, &mut yeff)
                 });
                 let yj = &yeff;
                 let tracked = self.targets.is_some() && self.track_weight > 0.0;
@@ -308,6 +303,7 @@ impl Nlp for MinimaxProblem {
         let mut gbar = vec![0.0; nv];
         let mut row = 0;
         let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
+        let ns = self.sample_rows();
         for (j, &k) in self.ks.iter().enumerate() {
             if !(k > 0.0 && k < 1.0) {
                 continue;
@@ -324,23 +320,12 @@ impl Nlp for MinimaxProblem {
             let (blocks, offsets, aj) = (&self.blocks, &self.offsets, &self.a[j]);
             let mut yj = y[row..row + per].to_vec();
             // The swept rows' share of this sample's obstacle rows, and their chord terms.
-            let mut chord = Adjoint::new(model);
             if let Some(sw) = &self.swept {
-                let ys = &y[self.interior.len() * per..];
-                sw.add_sample_weights(
-                    row / per,
-                    ys,
-                    offsets,
-                    &interior_shapes,
-                    &mut yj,
-                    &mut chord,
-                );
+                sw.add_sample_weights(row / per, &y[ns..], offsets, &mut yj);
             }
             add_weighted_curvature(blocks, offsets, model, aj, shape, &yj, &mut self.adj, ha);
-            for (p, c) in self.adj.pos.iter_mut().zip(&chord.pos) {
-                for (pv, cv) in p.iter_mut().zip(c) {
-                    *pv += cv;
-                }
+            if let Some(sw) = &self.swept {
+                sw.add_chord_cotangents(row / per, &y[ns..], &interior_shapes, &mut self.adj);
             }
             if let (true, Some(t)) = (tracked, &self.targets) {
                 let tj = &t[j];
@@ -358,7 +343,6 @@ impl Nlp for MinimaxProblem {
             row += per;
         }
         if let Some(sw) = &self.swept {
-            let ns = self.sample_rows();
             let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
             let a: Vec<&[f64]> = self.interior.iter().map(|&i| &self.a[i][..]).collect();
             sw.add_coupling_hessian(

@@ -107,21 +107,16 @@ impl Swept {
         }
     }
 
-    /// For interior sample `i`: adds the swept rows' share of the obstacle rows' weights to
-    /// `w` (the sample's `per` weights) and their chord terms to `adj`, for swept multipliers
-    /// `y` (all swept rows). Returns whether any weight was non-zero.
-    pub fn add_sample_weights(
+    /// Calls `f(block, row in block, boundary, pair, sign, yᵣ)` for every swept row with a
+    /// non-zero multiplier `yᵣ` that involves interior sample `i` (`sign` is `+1` where the
+    /// sample ends the pair, `−1` where it starts it).
+    fn touching(
         &self,
         i: usize,
         y: &[f64],
-        block_offsets: &[usize],
-        shapes: &[&Shape],
-        w: &mut [f64],
-        adj: &mut Adjoint,
-    ) -> bool {
+        mut f: impl FnMut(usize, usize, usize, usize, f64, f64),
+    ) {
         let rp = self.rows_per_pair();
-        let mut any = false;
-        // Pair i−1 ends at sample i (sign +), pair i starts there (sign −).
         for (p, sign) in [(i.checked_sub(1), 1.0), (Some(i), -1.0)] {
             let Some(p) = p.filter(|&p| p < self.pairs) else {
                 continue;
@@ -129,23 +124,46 @@ impl Swept {
             for (o, (blk, samples)) in self.obstacles.iter().enumerate() {
                 for (r, &b) in samples.iter().enumerate() {
                     let yr = y[p * rp + self.offsets[o] + r];
-                    if yr == 0.0 {
-                        continue;
+                    if yr != 0.0 {
+                        f(*blk, r, b, p, sign, yr);
                     }
-                    any = true;
-                    w[block_offsets[*blk] + r] += 0.5 * yr;
-                    let (_, u, _) = Self::chord(shapes[p].positions[b], shapes[p + 1].positions[b]);
-                    adj.add_pos(b, sign * 0.5 * yr, u);
                 }
             }
         }
+    }
+
+    /// For interior sample `i`: adds the swept rows' share `½ yᵣ` of its obstacle rows'
+    /// weights to `w` (the sample's `per` weights), for swept multipliers `y` (all swept rows).
+    /// Returns whether any swept multiplier touching the sample is non-zero.
+    pub fn add_sample_weights(
+        &self,
+        i: usize,
+        y: &[f64],
+        block_offsets: &[usize],
+        w: &mut [f64],
+    ) -> bool {
+        let mut any = false;
+        self.touching(i, y, |blk, r, _, _, _, yr| {
+            any = true;
+            w[block_offsets[blk] + r] += 0.5 * yr;
+        });
         any
+    }
+
+    /// For interior sample `i`: adds the swept rows' chord terms `±½ yᵣ u` (u the chord's unit
+    /// direction) at their boundaries to `adj`.
+    pub fn add_chord_cotangents(&self, i: usize, y: &[f64], shapes: &[&Shape], adj: &mut Adjoint) {
+        self.touching(i, y, |_, _, b, p, sign, yr| {
+            let (_, u, _) = Self::chord(shapes[p].positions[b], shapes[p + 1].positions[b]);
+            adj.add_pos(b, sign * 0.5 * yr, u);
+        });
     }
 
     /// Adds the parts of the swept rows' Hessian that couple two samples to `h` (`z` space):
     /// the chord's curvature `½ yᵣ DᵀH D` (D = ∂(x_{i+1} − x_i)/∂z, H the Hessian of `|Δ|_δ`),
     /// and the penalty's Gauss–Newton part `sᵣ ∇cᵣ∇cᵣᵀ`. The per-sample parts (the obstacle
-    /// distance's and the positions' curvature) come through [`Swept::add_sample_weights`].
+    /// distance's and the positions' curvature) come through [`Swept::add_sample_weights`] and
+    /// [`Swept::add_chord_cotangents`].
     /// `kin`, `a` and `shapes` hold the interior samples only.
     #[allow(clippy::too_many_arguments)]
     pub fn add_coupling_hessian(
