@@ -157,6 +157,23 @@ impl MinimaxProblem {
 }
 
 impl MinimaxProblem {
+    /// Largest distance (dimensionless) between a boundary position of the path `z`'s sampled
+    /// shapes and the same boundary of `targets` (boundary positions per sample).
+    pub fn distance_to(&self, z: &[f64], targets: &[Vec<[f64; 3]>]) -> f64 {
+        let mut a = vec![0.0; self.path.n()];
+        let mut shape = Shape::default();
+        let mut worst: f64 = 0.0;
+        for (&k, tj) in self.ks.iter().zip(targets) {
+            self.path.shape_at(z, k, &mut a);
+            self.model.evaluate_into(&a, &mut shape);
+            for (x, xb) in shape.positions.iter().zip(tj) {
+                let d2: f64 = (0..3).map(|i| (x[i] - xb[i]).powi(2)).sum();
+                worst = worst.max(d2.sqrt());
+            }
+        }
+        worst
+    }
+
     /// The tracking term at the last evaluated point.
     pub fn tracking(&self) -> f64 {
         let Some(t) = &self.targets else { return 0.0 };

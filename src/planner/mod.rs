@@ -78,6 +78,9 @@ pub struct StartSummary {
     pub violation: f64,
     /// Objective evaluations.
     pub evaluations: usize,
+    /// Equilibrium-tracking rounds run (at most `equilibrium_rounds`; fewer when the sampled
+    /// shapes already lie on their equilibria or a round stops bringing them closer).
+    pub tracking_rounds: usize,
 }
 
 /// The outcome of [`Planner::run`].
@@ -254,6 +257,14 @@ fn end_shape(
     Ok(sol)
 }
 
+/// Equilibrium tracking ends once the sampled shapes lie within this fraction of the coincidence
+/// tolerance from the equilibria of their end poses.
+const TRACK_DONE: f64 = 0.1;
+
+/// Equilibrium tracking ends after a round that brings the sampled shapes less than this
+/// fraction closer to their equilibria.
+const TRACK_PROGRESS: f64 = 0.1;
+
 /// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
 fn noise(seed: u64, n: usize) -> Vec<f64> {
     let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
@@ -294,6 +305,7 @@ struct StartRun {
     violation: f64,
     sampled_max: f64,
     evaluations: usize,
+    tracking_rounds: usize,
     progress: Vec<(Progress, Vec<f64>)>,
 }
 
@@ -445,6 +457,7 @@ impl Planner {
         }
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
+        let mut tracking_rounds = 0;
         if tally.status != AlStatus::NumericalFailure && self.options.track_weight > 0.0 {
             p.track_weight = self.options.track_weight;
             // Targets keep the optimiser's safety margin from obstacles.
@@ -456,6 +469,11 @@ impl Planner {
                     *con = Box::new(o);
                 }
             }
+            // Rounds stop early when the sampled shapes already lie within `TRACK_DONE` of the
+            // coincidence tolerance from their equilibria, or when a round brought them less
+            // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
+            let done = TRACK_DONE * self.options.tolerance;
+            let mut dev_prev = f64::INFINITY;
             for _ in 0..self.options.track_rounds {
                 let targets = replay::equilibria(
                     &inflated,
@@ -472,11 +490,15 @@ impl Planner {
                         .map(|(u, v)| (0..3).map(|i| (u[i] - v[i]).abs()).fold(0.0, f64::max))
                         .fold(0.0, f64::max)
                 });
+                // The replay's deviation, estimated on the samples.
+                let dev = p.distance_to(&z, &targets);
                 p.targets = Some(targets);
                 // Targets that no longer move: the path already sits on its equilibria.
-                if moved < 1e-4 {
+                if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
                     break;
                 }
+                dev_prev = dev;
+                tracking_rounds += 1;
                 // Newton steps here in either mode: the sharpness stages have chosen the route,
                 // and tracking only pulls its shapes onto their equilibria.
                 let al_t = AlOptions {
@@ -508,6 +530,7 @@ impl Planner {
             violation: tally.violation,
             sampled_max,
             evaluations: tally.evaluations,
+            tracking_rounds,
             progress,
         }
     }
@@ -767,6 +790,7 @@ impl Planner {
                     sampled_u_max: r.sampled_max,
                     violation: r.violation,
                     evaluations: r.evaluations,
+                    tracking_rounds: r.tracking_rounds,
                 })
                 .collect(),
             chosen_start: best,
