@@ -500,7 +500,7 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
                 if result.replay.snaps.is_empty() {
                     String::new()
                 } else {
-                    format!(", snap-through at k = {:?}", result.replay.snaps)
+                    format!(", snap-through at k = {}", snap_list(&result.replay.snaps))
                 }
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
@@ -547,7 +547,7 @@ fn plan_summary(r: &PlanReport) -> String {
     let rp = &p.replay;
     let _ = writeln!(
         o,
-        "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snaps {:?}",
+        "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snap-through at k = [{}]",
         rp.max_deviation_over_l,
         rp.k_at_max_deviation,
         rp.tolerance,
@@ -559,7 +559,7 @@ fn plan_summary(r: &PlanReport) -> String {
         rp.u_max,
         rp.all_stable,
         rp.all_converged,
-        rp.snaps
+        snap_list(&rp.snaps)
     );
     let _ = writeln!(
         o,
@@ -567,6 +567,15 @@ fn plan_summary(r: &PlanReport) -> String {
         r.mcap, r.log_shapes, p.timing_s.endpoints, p.timing_s.plan, p.timing_s.replay
     );
     o
+}
+
+/// The `k` of snap-throughs, four decimals each.
+fn snap_list(snaps: &[f64]) -> String {
+    snaps
+        .iter()
+        .map(|k| format!("{k:.4}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, ExitCode> {

@@ -296,6 +296,88 @@ fn twin_shapes_need_the_end_pulled_straight() {
     assert!(u_min < 0.01 * tracked.replay.steps[0].u_feasible, "{u_min}");
 }
 
+/// Records the replayed shapes' coefficients.
+#[derive(Default)]
+struct Feasible(Vec<(f64, Vec<f64>)>);
+
+impl dlo_planner::planner::observer::PlanObserver for Feasible {
+    fn shape(
+        &mut self,
+        _model: &dlo_planner::model::Model,
+        r: &dlo_planner::planner::observer::ShapeRecord,
+    ) {
+        if r.kind == dlo_planner::planner::observer::PathKind::Feasible {
+            self.0.push((r.k, r.a.to_vec()));
+        }
+    }
+}
+
+/// A clamped strip buckled into an arch (end at 0.8 L, θ(L) = 0), planned to a shape with the
+/// end turned by 0.8 rad. Driven by the end pose alone, the replay stays on a branch of
+/// equilibria the plan leaves, until that branch ends and the strip snaps onto the plan's. The
+/// snap survives every bisection of its step: the replay reports it and the verdict is
+/// negative. Each snap is a real one: between two replayed equilibria (both converged and
+/// stable) at most 1/640 apart in k the shape jumps by more than 0.02 L and the energy drops —
+/// the strip releases energy — while the plan's own energy hardly changes.
+#[test]
+fn replay_reports_snap_through() {
+    let arch = |sign: f64| format!("[0, 0, {}, 0, 0, 0, 0, 0, 0, 0]", 1.2 * sign);
+    let text = plan_text(
+        &format!(
+            r#"{{ "x": 0.0, "z": 0.8, "theta": 0.0, "shape": {{ "theta": {} }} }}"#,
+            arch(1.0)
+        ),
+        &format!(
+            r#"{{ "x": 0.0, "z": 0.8, "theta": 0.8, "shape": {{ "theta": {} }} }}"#,
+            arch(-1.0)
+        ),
+        "",
+    );
+    let c = case::parse(&text, Path::new("snap.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let mut rec = Feasible::default();
+    let r = p.run(&mut rec);
+    assert_eq!(r.status, PlanStatus::Planned);
+    assert!(!r.replay.snaps.is_empty());
+    assert!(!r.replay.coincide);
+    let model = &p.base.model;
+    let finest = 1.0 / (p.options.replay_steps as f64 * 2f64.powi(p.options.refinements as i32));
+    for &k in &r.replay.snaps {
+        let i = r.replay.steps.iter().position(|s| s.k == k).unwrap();
+        let (before, after) = (&r.replay.steps[i - 1], &r.replay.steps[i]);
+        assert!(
+            k - before.k <= finest * (1.0 + 1e-9),
+            "snap at {k}: step {}",
+            k - before.k
+        );
+        for s in [before, after] {
+            assert!(s.converged && s.stable == Some(true), "k = {}", s.k);
+        }
+        let released = (before.u_feasible - after.u_feasible) / before.u_feasible;
+        assert!(
+            released > 0.1,
+            "snap at {k}: energy {} -> {}",
+            before.u_feasible,
+            after.u_feasible
+        );
+        let plan_change = (before.u_optimal - after.u_optimal).abs() / before.u_optimal;
+        assert!(
+            plan_change < 0.02,
+            "snap at {k}: the plan's energy changes by {plan_change}"
+        );
+        let shape_at = |kk: f64| {
+            let a = &rec.0.iter().find(|(q, _)| *q == kk).unwrap().1;
+            model.evaluate(a).positions
+        };
+        let jump = shape_at(before.k)
+            .iter()
+            .zip(shape_at(k))
+            .map(|(u, v)| ((u[0] - v[0]).powi(2) + (u[2] - v[2]).powi(2)).sqrt())
+            .fold(0.0, f64::max);
+        assert!(jump > 0.02, "snap at {k}: the shape moves {jump} L");
+    }
+}
+
 /// Bad planning inputs are errors that name the field.
 #[test]
 fn bad_planning_inputs_name_the_field() {
