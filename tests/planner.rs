@@ -378,6 +378,33 @@ fn replay_reports_snap_through() {
     }
 }
 
+/// Self-contact along a plan: on the straight-line path of `common::spiral_case` the tip passes
+/// through the coil (the verification grid finds the strip crossing itself); the plan, with
+/// the self-contact rows at its samples, keeps every pair of chords 2r apart on the
+/// verification grid, which it never saw. (Here the plan uncurls the strip on the way, so the
+/// rows need not push: planned without them it stays clear too.)
+#[test]
+fn plan_keeps_the_rod_from_crossing_itself() {
+    use dlo_planner::planner::verify::verify_with;
+    let p = Planner::from_case(&common::spiral_case(true)).unwrap();
+    let path = p.path();
+    let fine = fine_model(&p.base.model, 256, 4);
+    let gap = |z: &[f64]| {
+        let v = verify_with(&fine, &path, z, 201, &[], p.base.objective, true);
+        v.self_contact.unwrap().0
+    };
+    let straight = gap(&vec![0.0; path.n_vars()]);
+    assert!(straight < -0.005, "straight-line path: gap {straight}");
+    let r = p.run(&mut Silent);
+    assert_eq!(r.status, PlanStatus::Planned);
+    let planned = gap(&r.z);
+    assert!(planned >= 0.0, "plan: gap {planned}");
+    assert_eq!(
+        r.verification.self_contact.map(|(g, _)| g >= 0.0),
+        Some(true)
+    );
+}
+
 /// Bad planning inputs are errors that name the field.
 #[test]
 fn bad_planning_inputs_name_the_field() {

@@ -42,10 +42,15 @@ fn check(name: &str, tracking: bool) {
 }
 
 fn check_with(name: &str, tracking: bool, swept: bool) {
-    let (mut p, z) = setup_with(name, tracking, swept);
+    let (p, z) = setup_with(name, tracking, swept);
     if swept {
         assert!(p.m() > p.sample_rows(), "{name}: no swept rows");
     }
+    check_gradient(&format!("{name} (tracking {tracking})"), p, &z);
+}
+
+fn check_gradient(name: &str, mut p: MinimaxProblem, z: &[f64]) {
+    let z = z.to_vec();
     let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
     let mut c = vec![0.0; m];
@@ -68,10 +73,24 @@ fn check_with(name: &str, tracking: bool, swept: bool) {
         let scale = g.iter().fold(1e-8_f64, |a, v| a.max(v.abs()));
         worst = worst.max((fd - g[i]).abs() / scale);
     }
-    assert!(
-        worst < 1e-6,
-        "{name} (tracking {tracking}): relative error {worst:e}"
-    );
+    assert!(worst < 1e-6, "{name}: relative error {worst:e}");
+}
+
+/// The self-contact rows at every sample, chained through the path: a strip curled into a
+/// spiral (`common::spiral_case`), on a path whose middle samples bring the coil close to
+/// itself.
+#[test]
+fn minimax_gradient_with_self_contact_matches_finite_differences() {
+    let pl = Planner::from_case(&common::spiral_case(true)).unwrap();
+    let ks: Vec<f64> = (0..9).map(|j| j as f64 / 8.0).collect();
+    let mut p = pl.minimax_problem_at(ks);
+    p.beta = 3.0;
+    p.mean_weight = 0.7;
+    assert!(p.rows_per_sample() > 0, "no self-contact rows");
+    let z: Vec<f64> = (0..p.n())
+        .map(|i| 0.05 * ((i as f64) * 1.7).sin())
+        .collect();
+    check_gradient("spiral with self-contact", p, &z);
 }
 
 #[test]

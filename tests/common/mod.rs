@@ -136,3 +136,27 @@ pub fn shipped_variant(
     edit(&mut v);
     dlo_planner::case::parse(&v.to_string(), &std::path::Path::new("variant").join(name)).unwrap()
 }
+
+/// A free planar strip (base fixed in position only) planned from a spiral that turns by 7 rad
+/// tightening towards its tip (θ ≈ 7t², least-squares fit in the Ritz basis: the tip inside
+/// the coil) to its mirror in the basis, the spiral loosening towards its tip (θ ≈ 7(1 − (1 −
+/// t)²): the tip outside). Halfway along the straight-line path the strip is a circle lapping
+/// over itself.
+#[allow(dead_code)]
+pub fn spiral_case(self_contact: bool) -> dlo_planner::case::Case {
+    let inward = [
+        -1.166275, 7.0, 0.0, 0.710032, 0.0, 0.178096, 0.0, 0.079589, 0.0, 0.045112,
+    ];
+    let outward: Vec<f64> = inward
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| if i == 1 { v } else { -v })
+        .collect();
+    let text = format!(
+        r#"{{ "name": "spiral", "self_contact": {self_contact},
+  "rod": {{ "length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005 }},
+  "plan": {{ "start": {{ "shape": {{ "theta": {inward:?} }} }},
+            "goal": {{ "shape": {{ "theta": {outward:?} }} }}, "k_samples": 21 }} }}"#
+    );
+    dlo_planner::case::parse(&text, std::path::Path::new("spiral.json")).unwrap()
+}
