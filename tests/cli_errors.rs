@@ -384,3 +384,130 @@ fn plan_margin_and_log_commands_reject_bad_input() {
     assert!(!dir.join("fixed.mcap").exists(), "no half-written output");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `dlo plan --json` prints the documented keys, and its exit code tells the three outcomes
+/// apart: 0 for a collision-free plan whose replay coincides, 4 when the verification grid
+/// finds penetration, 5 when the replay does not coincide (here: it snaps through). The JSON
+/// and a readable log are written in every case; the errors name the file.
+#[test]
+fn plan_prints_documented_json_and_exit_codes() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let logs = dir.join("logs");
+    let logs_s = logs.to_str().unwrap();
+    let json = |out: &str| -> serde_json::Value { serde_json::from_str(out).unwrap() };
+    let log_ok = |name: &str| {
+        let bytes = std::fs::read(logs.join(format!("{name}.mcap"))).unwrap();
+        assert!(bytes.starts_with(b"\x89MCAP0\r\n") && bytes.ends_with(b"\x89MCAP0\r\n"));
+    };
+
+    let pillar = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/plan_cable_around_pillar.json"
+    );
+    let (code, out, err) = run(&["plan", pillar, "--json", "--log-dir", logs_s]);
+    assert_eq!(code, 0, "{err}");
+    let v = json(&out);
+    for key in [
+        "status",
+        "u_max",
+        "u_max_straight",
+        "min_clearance",
+        "violation",
+        "replay",
+        "mcap",
+        "timing_s",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    for key in [
+        "max_deviation_over_l",
+        "k_at_max_deviation",
+        "u_max",
+        "all_stable",
+        "coincide",
+    ] {
+        assert!(v["replay"].get(key).is_some(), "missing replay.{key}");
+    }
+    assert!(v["timing_s"]["plan"].as_f64().unwrap() > 0.0);
+    assert!(v["timing_s"]["replay"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["status"], "planned");
+    assert_eq!(v["replay"]["coincide"], true);
+    assert!(
+        v["mcap"]
+            .as_str()
+            .unwrap()
+            .ends_with("plan_cable_around_pillar.mcap")
+    );
+    log_ok("plan_cable_around_pillar");
+
+    // The paper's scheme as written (21 samples, no margin, no mean energy, no tracking, no
+    // refinement) tunnels through the block.
+    let mut c: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/planning_cases/plan_paper_planar.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    c["name"] = "tunnels".into();
+    for (k, val) in [
+        ("path_terms", serde_json::json!(3)),
+        ("safety_margin", serde_json::json!(0.0)),
+        ("sharpness", serde_json::json!([10, 100, 1000])),
+        ("starts", serde_json::json!(1)),
+        ("k_samples", serde_json::json!(21)),
+        ("mean_weight", serde_json::json!(0.0)),
+        ("equilibrium_weight", serde_json::json!(0.0)),
+        ("sample_refinements", serde_json::json!(0)),
+    ] {
+        c["plan"][k] = val;
+    }
+    let tunnels = dir.join("tunnels.json");
+    std::fs::write(&tunnels, c.to_string()).unwrap();
+    let (code, out, err) = run(&[
+        "plan",
+        tunnels.to_str().unwrap(),
+        "--json",
+        "--log-dir",
+        logs_s,
+    ]);
+    assert_eq!(code, 4, "{err}");
+    let v = json(&out);
+    assert_eq!(v["status"], "collision");
+    assert!(v["min_clearance"].as_f64().unwrap() < 0.0);
+    assert!(err.contains("tunnels.json"), "{err}");
+    log_ok("tunnels");
+
+    // A buckled arch planned to a turned end: the replay snaps through (tests/planner.rs).
+    let snap = dir.join("snap.json");
+    std::fs::write(
+        &snap,
+        r#"{ "name": "snap",
+  "rod": { "length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005 },
+  "constraints": [ { "type": "orientation", "s": 0.0, "theta": 0.0 } ],
+  "plan": {
+    "start": { "x": 0.0, "z": 0.8, "theta": 0.0, "shape": { "theta": [0, 0, 1.2, 0, 0, 0, 0, 0, 0, 0] } },
+    "goal": { "x": 0.0, "z": 0.8, "theta": 0.8, "shape": { "theta": [0, 0, -1.2, 0, 0, 0, 0, 0, 0, 0] } },
+    "k_samples": 21 } }"#,
+    )
+    .unwrap();
+    let (code, out, err) = run(&[
+        "plan",
+        snap.to_str().unwrap(),
+        "--json",
+        "--log-dir",
+        logs_s,
+    ]);
+    assert_eq!(code, 5, "{err}");
+    let v = json(&out);
+    assert_eq!(v["status"], "planned");
+    assert_eq!(v["replay"]["coincide"], false);
+    assert!(!v["replay"]["snaps"].as_array().unwrap().is_empty());
+    assert!(
+        err.contains("snap.json") && err.contains("snap-through"),
+        "{err}"
+    );
+    log_ok("snap");
+}
