@@ -160,7 +160,11 @@ static ACTIVE_LOG: OnceLock<SharedWriter> = OnceLock::new();
 fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode> {
     let path = dir.join(format!("{name}.mcap"));
     let w = McapWriter::create(&path).map_err(|e| {
-        eprintln!("error: {}: cannot create the log: {e}", path.display());
+        eprintln!(
+            "error: {}: cannot create the log: {}",
+            path.display(),
+            causes(&e)
+        );
         ExitCode::from(EXIT_OUTPUT)
     })?;
     let shared: SharedWriter = Arc::new(Mutex::new(w));
@@ -180,7 +184,11 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
 /// Finishes a log; reports failure as exit code 1.
 fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
     dlo_planner::mcap_log::lock(w).finish().map_err(|e| {
-        eprintln!("error: {}: cannot finish the log: {e}", path.display());
+        eprintln!(
+            "error: {}: cannot finish the log: {}",
+            path.display(),
+            causes(&e)
+        );
         ExitCode::from(EXIT_OUTPUT)
     })
 }
@@ -207,7 +215,7 @@ fn run_shape(path: &std::path::Path, json: bool, log_dir: &Path) -> ExitCode {
     let report = ShapeReport::solved(&c.name, &c.problem, &sol, &c.report_points, secs);
     let metrics = serde_json::to_value(&report).expect("report serialises");
     let logged = log_static(&log, &c.problem.model, &c.obstacles, &sol.a, &metrics)
-        .map_err(|e| e.to_string())
+        .map_err(|e| causes(&e))
         .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
     if let Err(e) = logged {
         eprintln!("error: {}: cannot write the log: {e}", log_path.display());
@@ -417,7 +425,11 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         eprintln!();
     }
     if let Some(e) = obs.log.error() {
-        eprintln!("error: {}: cannot write the log: {e}", log_path.display());
+        eprintln!(
+            "error: {}: cannot write the log: {}",
+            log_path.display(),
+            causes(e)
+        );
         let _ = close_log(&log, &log_path);
         return ExitCode::from(EXIT_OUTPUT);
     }
@@ -567,6 +579,18 @@ fn plan_summary(r: &PlanReport) -> String {
         r.mcap, r.log_shapes, p.timing_s.endpoints, p.timing_s.plan, p.timing_s.replay
     );
     o
+}
+
+/// An error and its chain of causes, `outer: inner: …` (the MCAP crate wraps I/O errors in a
+/// generic message whose cause says what went wrong).
+fn causes(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(&format!(": {s}"));
+        source = s.source();
+    }
+    text
 }
 
 /// The `k` of snap-throughs, four decimals each.
@@ -750,7 +774,7 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         eprintln!();
     }
     let logged = dlo_planner::mcap_log::log_margin(&log, &c.problem.model, &c.obstacles, &margin)
-        .map_err(|e| e.to_string())
+        .map_err(|e| causes(&e))
         .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
     if let Err(e) = logged {
         eprintln!("error: {}: cannot write the log: {e}", log_path.display());

@@ -511,3 +511,54 @@ fn plan_prints_documented_json_and_exit_codes() {
     );
     log_ok("snap");
 }
+
+/// Exit 3: a solve that runs out of its budget prints its summary (status `iteration_limit`)
+/// and says so; exit 1: a log that cannot be created names the file and the system's reason.
+#[test]
+fn unconverged_solve_and_unwritable_log_exit_codes() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-codes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let shipped = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/pinned_buckling_080.json"
+    );
+    let mut c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(shipped).unwrap()).unwrap();
+    c["name"] = "budget".into();
+    c["solver"]["max_outer"] = 1.into();
+    let budget = dir.join("budget.json");
+    std::fs::write(&budget, c.to_string()).unwrap();
+    let logs = dir.join("logs");
+    let (code, out, err) = run(&[
+        "shape",
+        budget.to_str().unwrap(),
+        "--json",
+        "--log-dir",
+        logs.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 3, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["status"], "iteration_limit");
+    assert!(
+        err.contains("budget.json") && err.contains("did not converge"),
+        "{err}"
+    );
+    assert!(logs.join("budget.mcap").exists());
+
+    // A file where the log directory should be.
+    let blocker = dir.join("blocker");
+    std::fs::write(&blocker, "").unwrap();
+    let (code, out, err) = run(&[
+        "shape",
+        shipped,
+        "--log-dir",
+        blocker.join("logs").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(out.is_empty(), "{out}");
+    assert!(
+        err.contains("pinned_buckling_080.mcap") && err.contains("cannot create the log"),
+        "{err}"
+    );
+    assert!(err.contains("os error"), "the system's reason: {err}");
+}
