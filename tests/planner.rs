@@ -534,6 +534,61 @@ fn multi_start_reports_every_start_keeps_the_best_and_reproduces() {
     assert_eq!(single.starts[0].evaluations, r.starts[0].evaluations);
 }
 
+/// Records when the optimiser's progress and the phases arrive.
+#[derive(Default)]
+struct Timeline {
+    phases: Vec<(String, std::time::Instant)>,
+    progress: Vec<(usize, std::time::Instant)>,
+}
+
+impl dlo_planner::planner::observer::PlanObserver for Timeline {
+    fn phase(&mut self, name: &str) {
+        self.phases
+            .push((name.to_string(), std::time::Instant::now()));
+    }
+    fn progress(
+        &mut self,
+        _model: &dlo_planner::model::Model,
+        p: &dlo_planner::planner::observer::Progress,
+        _worst: &[f64],
+    ) {
+        self.progress.push((p.start, std::time::Instant::now()));
+    }
+}
+
+/// Progress is live: with starts on parallel threads, the observer hears of each outer
+/// iteration while the starts run, not when they have all finished. The first report
+/// arrives within the first half of the optimisation (it follows the first of some fifty
+/// outer iterations), and every start reports.
+#[test]
+fn multi_start_progress_arrives_while_the_starts_run() {
+    let text = plan_text(
+        r#"{ "x": 0.3, "z": 0.9, "theta": 0.6 }"#,
+        r#"{ "x": -0.25, "z": 0.85, "theta": -0.8 }"#,
+        "",
+    )
+    .replace(r#""k_samples": 21"#, r#""k_samples": 21, "starts": 3"#);
+    let c = case::parse(&text, Path::new("live.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let mut t = Timeline::default();
+    p.run(&mut t);
+    let at = |name: &str| t.phases.iter().find(|(n, _)| n == name).unwrap().1;
+    let (begin, end) = (at("optimise"), at("verify"));
+    let first = t.progress.first().unwrap().1;
+    let whole = (end - begin).as_secs_f64();
+    let waited = (first - begin).as_secs_f64();
+    assert!(
+        waited < 0.5 * whole,
+        "first report after {waited} s of {whole} s"
+    );
+    for s in 0..3 {
+        assert!(
+            t.progress.iter().any(|(i, _)| *i == s),
+            "start {s} reported nothing"
+        );
+    }
+}
+
 /// A shipped case's planner and its plan.
 fn planned(name: &str) -> (Planner, dlo_planner::planner::PlanResult) {
     let c = case::load(&Path::new("planning_cases").join(name)).unwrap();

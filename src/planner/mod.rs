@@ -306,7 +306,6 @@ struct StartRun {
     sampled_max: f64,
     evaluations: usize,
     tracking_rounds: usize,
-    progress: Vec<(Progress, Vec<f64>)>,
 }
 
 impl Planner {
@@ -374,12 +373,15 @@ impl Planner {
         p
     }
 
+    /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
+    /// `sink` each outer iteration's progress and worst sampled shape as it happens.
     fn optimise_from(
         &self,
         start: usize,
         z0: Vec<f64>,
         ks: &[f64],
         first_stage: usize,
+        sink: &mut dyn FnMut(Progress, Vec<f64>),
     ) -> StartRun {
         let mut p = self.minimax_problem_at(ks.to_vec());
         let unit = self.base.model.rod.energy_unit();
@@ -399,7 +401,6 @@ impl Planner {
             violation: f64::INFINITY,
             evaluations: 0,
         };
-        let mut progress = Vec::new();
         let al = AlOptions {
             feasibility_tol: 1e-6,
             optimality_tol: 1e-5,
@@ -417,7 +418,7 @@ impl Planner {
             p.beta = b / u_ref;
             let out = {
                 let pp = &mut p;
-                let progress = &mut progress;
+                let sink = &mut *sink;
                 let mut cbuf = vec![0.0; crate::optim::Nlp::m(pp)];
                 let ks = pp.ks.clone();
                 let beta = pp.beta;
@@ -436,7 +437,7 @@ impl Planner {
                         .max_by(|a, b| a.1.total_cmp(b.1))
                         .expect("samples");
                     let mean = u.iter().sum::<f64>() / u.len() as f64;
-                    progress.push((
+                    sink(
                         Progress {
                             start,
                             stage,
@@ -448,7 +449,7 @@ impl Planner {
                             rho: it.rho,
                         },
                         probe.sampled()[j].clone(),
-                    ));
+                    );
                 })
             };
             if tally.absorb(out) {
@@ -531,7 +532,6 @@ impl Planner {
             sampled_max,
             evaluations: tally.evaluations,
             tracking_rounds,
-            progress,
         }
     }
 
@@ -616,12 +616,16 @@ impl Planner {
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let runs: Vec<StartRun> = if starts.len() == 1 {
-            vec![self.optimise_from(0, starts[0].clone(), &uniform, 0)]
+            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
+            vec![self.optimise_from(0, starts[0].clone(), &uniform, 0, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
                 .min(starts.len());
             let mut results: Vec<Option<StartRun>> = (0..starts.len()).map(|_| None).collect();
+            // The starts report their progress through a channel, which this thread passes on
+            // to the observer while they run.
+            let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
             std::thread::scope(|sc| {
                 let chunks: Vec<Vec<usize>> = (0..workers)
                     .map(|w| (w..starts.len()).step_by(workers).collect())
@@ -631,13 +635,25 @@ impl Planner {
                     .map(|idx| {
                         let starts = &starts;
                         let uniform = &uniform;
+                        let tx = tx.clone();
                         sc.spawn(move || {
+                            let mut sink = |p: Progress, w: Vec<f64>| {
+                                // The receiver outlives every start.
+                                let _ = tx.send((p, w));
+                            };
                             idx.into_iter()
-                                .map(|i| (i, self.optimise_from(i, starts[i].clone(), uniform, 0)))
+                                .map(|i| {
+                                    let z0 = starts[i].clone();
+                                    (i, self.optimise_from(i, z0, uniform, 0, &mut sink))
+                                })
                                 .collect::<Vec<_>>()
                         })
                     })
                     .collect();
+                drop(tx);
+                for (p, w) in rx {
+                    observer.progress(model, &p, &w);
+                }
                 for h in handles {
                     for (i, r) in h.join().expect("optimiser thread") {
                         results[i] = Some(r);
@@ -649,11 +665,6 @@ impl Planner {
                 .map(|r| r.expect("every start ran"))
                 .collect()
         };
-        for r in &runs {
-            for (pr, worst) in &r.progress {
-                observer.progress(model, pr, worst);
-            }
-        }
         let feasible = |r: &StartRun| r.violation <= 1e-6;
         let best = runs
             .iter()
@@ -725,10 +736,8 @@ impl Planner {
             observer.phase("optimise");
             // Warm: only the sharpest stage again.
             let last = self.options.sharpness.len() - 1;
-            let r = self.optimise_from(best, chosen.z.clone(), &ks, last);
-            for (pr, worst) in &r.progress {
-                observer.progress(model, pr, worst);
-            }
+            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
+            let r = self.optimise_from(best, chosen.z.clone(), &ks, last, &mut sink);
             chosen = StartRun {
                 evaluations: chosen.evaluations + r.evaluations,
                 ..r
