@@ -7,9 +7,12 @@
 pub mod endpoints;
 pub mod minimax;
 pub mod observer;
+mod optimise;
 pub mod replay;
+pub mod result;
 pub mod spec;
 pub mod swept;
+mod tracking;
 pub mod verify;
 
 use crate::case::Case;
@@ -20,18 +23,20 @@ use crate::constraints::{
 use crate::error::Error;
 use crate::kinematics::Shape;
 use crate::obstacle::Obstacle;
-use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
+use crate::optim::AlStatus;
 use crate::path::DeformationPath;
 use crate::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, Progress, ShapeRecord};
-use replay::{Replay, ReplayOptions, replay};
-use serde::Serialize;
+use replay::{ReplayOptions, replay};
 use spec::{End, PlanOptions};
 use std::sync::Arc;
 use verify::{Verification, fine_model, verify_with};
+
+use optimise::{StartRun, noise};
+pub use result::{PlanResult, PlanStatus, StartSummary, Timing};
 
 /// A planning problem ready to run: the held end's conditions, the obstacles, and the two
 /// solved end shapes.
@@ -51,88 +56,6 @@ pub struct Planner {
     pub goal: StaticSolution,
     /// Rows of the fixed conditions that are linear in the coefficients.
     pub linear_rows: Vec<Vec<f64>>,
-}
-
-/// How a plan ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PlanStatus {
-    /// The optimiser converged and the verification grid is collision-free.
-    Planned,
-    /// The verification grid finds a collision (e.g. tunnelling between samples).
-    Collision,
-    /// The optimiser did not converge (the path may still be collision-free).
-    NotConverged,
-}
-
-/// Summary of one optimiser start.
-#[derive(Clone, Debug, Serialize)]
-pub struct StartSummary {
-    /// Start index.
-    pub start: usize,
-    /// Final optimiser status.
-    pub status: AlStatus,
-    /// Largest sampled energy (case units).
-    pub sampled_u_max: f64,
-    /// Constraint violation (dimensionless).
-    pub violation: f64,
-    /// Objective evaluations.
-    pub evaluations: usize,
-    /// Equilibrium-tracking rounds run (at most `equilibrium_rounds`; fewer when the sampled
-    /// shapes already lie on their equilibria or a round stops bringing them closer).
-    pub tracking_rounds: usize,
-}
-
-/// The outcome of [`Planner::run`].
-#[derive(Clone, Debug, Serialize)]
-pub struct PlanResult {
-    /// Overall status.
-    pub status: PlanStatus,
-    /// Optimiser status of the chosen start.
-    pub optimiser: AlStatus,
-    /// True `U_max` of the plan on the verification grid (case units).
-    pub u_max: f64,
-    /// `k` where it occurs.
-    pub k_at_u_max: f64,
-    /// The largest energy on the optimiser's own `k` samples for the plan (case units): the
-    /// value it minimised, which `u_max` exceeds where a peak falls between samples.
-    pub sampled_u_max: f64,
-    /// `U_max` of the straight-line path `c = 0` (case units).
-    pub u_max_straight: f64,
-    /// Smallest obstacle clearance on the verification grid, optimal path (case units).
-    pub min_clearance: Option<f64>,
-    /// Smallest obstacle clearance of the straight-line path (case units).
-    pub min_clearance_straight: Option<f64>,
-    /// Largest violation of the optimiser's sampled constraints (dimensionless).
-    pub violation: f64,
-    /// Verification details of the plan.
-    pub verification: Verification,
-    /// Every start.
-    pub starts: Vec<StartSummary>,
-    /// The start the plan comes from (the lowest sampled `U_max` among the feasible ones).
-    pub chosen_start: usize,
-    /// Path vectors `cᵢ` (coefficient space).
-    pub path: Vec<Vec<f64>>,
-    /// The unknowns `z`.
-    #[serde(skip)]
-    pub z: Vec<f64>,
-    /// Feasibility replay.
-    pub replay: Replay,
-    /// `k` samples added where the verification grid found tunnelling or a missed energy peak.
-    pub added_samples: Vec<f64>,
-    /// Seconds spent planning (optimise + verify) and replaying.
-    pub timing_s: Timing,
-}
-
-/// Wall-clock times.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct Timing {
-    /// Start and goal solves.
-    pub endpoints: f64,
-    /// Optimisation and verification.
-    pub plan: f64,
-    /// Replay.
-    pub replay: f64,
 }
 
 /// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
@@ -257,57 +180,6 @@ fn end_shape(
     Ok(sol)
 }
 
-/// Equilibrium tracking ends once the sampled shapes lie within this fraction of the coincidence
-/// tolerance from the equilibria of their end poses.
-const TRACK_DONE: f64 = 0.1;
-
-/// Equilibrium tracking ends after a round that brings the sampled shapes less than this
-/// fraction closer to their equilibria.
-const TRACK_PROGRESS: f64 = 0.1;
-
-/// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
-fn noise(seed: u64, n: usize) -> Vec<f64> {
-    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    (0..n)
-        .map(|_| {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            let v = s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
-            2.0 * (v as f64 / (1u64 << 53) as f64) - 1.0
-        })
-        .collect()
-}
-
-/// What the multiplier-method calls of one start have produced so far.
-struct Tally {
-    lambda: Option<Vec<f64>>,
-    status: AlStatus,
-    violation: f64,
-    evaluations: usize,
-}
-
-impl Tally {
-    /// Takes in one call's outcome; true when it failed numerically (nothing more to do).
-    fn absorb(&mut self, out: crate::optim::AlOutcome) -> bool {
-        self.evaluations += out.evaluations;
-        self.status = out.status;
-        self.violation = out.max_violation;
-        self.lambda = Some(out.lambda);
-        self.status == AlStatus::NumericalFailure
-    }
-}
-
-#[derive(Clone)]
-struct StartRun {
-    z: Vec<f64>,
-    status: AlStatus,
-    violation: f64,
-    sampled_max: f64,
-    evaluations: usize,
-    tracking_rounds: usize,
-}
-
 impl Planner {
     /// Validates the case's `plan` section and solves the start and goal shapes.
     pub fn from_case(case: &Case) -> Result<Planner, Error> {
@@ -371,168 +243,6 @@ impl Planner {
         p.mean_weight = self.options.mean_weight;
         p.set_swept(self.options.swept);
         p
-    }
-
-    /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
-    /// `sink` each outer iteration's progress and worst sampled shape as it happens.
-    fn optimise_from(
-        &self,
-        start: usize,
-        z0: Vec<f64>,
-        ks: &[f64],
-        first_stage: usize,
-        sink: &mut dyn FnMut(Progress, Vec<f64>),
-    ) -> StartRun {
-        let mut p = self.minimax_problem_at(ks.to_vec());
-        let unit = self.base.model.rod.energy_unit();
-        let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
-        // Energy scale of the sharpness: the straight path's largest sampled energy.
-        let zero = vec![0.0; p.path.n_vars()];
-        crate::optim::Nlp::values(&mut p, &zero, &mut c);
-        let u_ref = p
-            .energies()
-            .iter()
-            .copied()
-            .fold(0.0_f64, f64::max)
-            .max(1e-3);
-        let mut tally = Tally {
-            lambda: None,
-            status: AlStatus::IterationLimit,
-            violation: f64::INFINITY,
-            evaluations: 0,
-        };
-        let al = AlOptions {
-            feasibility_tol: 1e-6,
-            optimality_tol: 1e-5,
-            rho_initial: 1e2,
-            rho_max: 1e8,
-            max_outer: 30,
-            max_inner: 300,
-            active_tol: 1e-7,
-            second_order: self.options.optimiser == spec::Optimiser::Newton,
-            max_step: f64::INFINITY,
-            newton_multipliers: false,
-        };
-        let mut z = z0;
-        for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
-            p.beta = b / u_ref;
-            let out = {
-                let pp = &mut p;
-                let sink = &mut *sink;
-                let mut cbuf = vec![0.0; crate::optim::Nlp::m(pp)];
-                let ks = pp.ks.clone();
-                let beta = pp.beta;
-                let mw = pp.mean_weight;
-                // The observer needs the sampled energies at the iterate: re-evaluate a cheap
-                // copy of the problem.
-                let mut probe = self.minimax_problem_at(ks.clone());
-                probe.beta = beta;
-                probe.mean_weight = mw;
-                augmented_lagrangian_observed(pp, &mut z, tally.lambda.as_deref(), al, &mut |it| {
-                    let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
-                    let u = probe.energies();
-                    let (j, &umax) = u
-                        .iter()
-                        .enumerate()
-                        .max_by(|a, b| a.1.total_cmp(b.1))
-                        .expect("samples");
-                    let mean = u.iter().sum::<f64>() / u.len() as f64;
-                    sink(
-                        Progress {
-                            start,
-                            stage,
-                            outer: it.outer,
-                            smoothed_max: (f - mw * mean) * unit,
-                            sampled_max: umax * unit,
-                            k_worst: ks[j],
-                            violation: it.violation,
-                            rho: it.rho,
-                        },
-                        probe.sampled()[j].clone(),
-                    );
-                })
-            };
-            if tally.absorb(out) {
-                break;
-            }
-        }
-        // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
-        // produces (see the README for why the paper's objective alone does not).
-        let mut tracking_rounds = 0;
-        if tally.status != AlStatus::NumericalFailure && self.options.track_weight > 0.0 {
-            p.track_weight = self.options.track_weight;
-            // Targets keep the optimiser's safety margin from obstacles.
-            let mut inflated = self.base.clone();
-            for con in inflated.constraints.iter_mut() {
-                if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
-                    let mut o = ob.clone();
-                    o.clearance += self.options.safety;
-                    *con = Box::new(o);
-                }
-            }
-            // Rounds stop early when the sampled shapes already lie within `TRACK_DONE` of the
-            // coincidence tolerance from their equilibria, or when a round brought them less
-            // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
-            let done = TRACK_DONE * self.options.tolerance;
-            let mut dev_prev = f64::INFINITY;
-            for _ in 0..self.options.track_rounds {
-                let targets = replay::equilibria(
-                    &inflated,
-                    &self.start,
-                    &p.path,
-                    &z,
-                    &p.ks,
-                    &self.static_options,
-                );
-                let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
-                    old.iter()
-                        .zip(&targets)
-                        .flat_map(|(a, b)| a.iter().zip(b))
-                        .map(|(u, v)| (0..3).map(|i| (u[i] - v[i]).abs()).fold(0.0, f64::max))
-                        .fold(0.0, f64::max)
-                });
-                // The replay's deviation, estimated on the samples.
-                let dev = p.distance_to(&z, &targets);
-                p.targets = Some(targets);
-                // Targets that no longer move: the path already sits on its equilibria.
-                if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
-                    break;
-                }
-                dev_prev = dev;
-                tracking_rounds += 1;
-                // Newton steps here in either mode: the sharpness stages have chosen the route,
-                // and tracking only pulls its shapes onto their equilibria.
-                let al_t = AlOptions {
-                    second_order: true,
-                    ..al
-                };
-                let out = augmented_lagrangian_observed(
-                    &mut p,
-                    &mut z,
-                    tally.lambda.as_deref(),
-                    al_t,
-                    &mut |_| {},
-                );
-                if tally.absorb(out) {
-                    break;
-                }
-            }
-        }
-        crate::optim::Nlp::values(&mut p, &z, &mut c);
-        let sampled_max = p
-            .energies()
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max)
-            * unit;
-        StartRun {
-            z,
-            status: tally.status,
-            violation: tally.violation,
-            sampled_max,
-            evaluations: tally.evaluations,
-            tracking_rounds,
-        }
     }
 
     /// Optimises, verifies and replays the plan.
@@ -615,56 +325,7 @@ impl Planner {
             .collect();
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
-        let runs: Vec<StartRun> = if starts.len() == 1 {
-            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
-            vec![self.optimise_from(0, starts[0].clone(), &uniform, 0, &mut sink)]
-        } else {
-            let workers = std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(starts.len());
-            let mut results: Vec<Option<StartRun>> = (0..starts.len()).map(|_| None).collect();
-            // The starts report their progress through a channel, which this thread passes on
-            // to the observer while they run.
-            let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
-            std::thread::scope(|sc| {
-                let chunks: Vec<Vec<usize>> = (0..workers)
-                    .map(|w| (w..starts.len()).step_by(workers).collect())
-                    .collect();
-                let handles: Vec<_> = chunks
-                    .into_iter()
-                    .map(|idx| {
-                        let starts = &starts;
-                        let uniform = &uniform;
-                        let tx = tx.clone();
-                        sc.spawn(move || {
-                            let mut sink = |p: Progress, w: Vec<f64>| {
-                                // The receiver outlives every start.
-                                let _ = tx.send((p, w));
-                            };
-                            idx.into_iter()
-                                .map(|i| {
-                                    let z0 = starts[i].clone();
-                                    (i, self.optimise_from(i, z0, uniform, 0, &mut sink))
-                                })
-                                .collect::<Vec<_>>()
-                        })
-                    })
-                    .collect();
-                drop(tx);
-                for (p, w) in rx {
-                    observer.progress(model, &p, &w);
-                }
-                for h in handles {
-                    for (i, r) in h.join().expect("optimiser thread") {
-                        results[i] = Some(r);
-                    }
-                }
-            });
-            results
-                .into_iter()
-                .map(|r| r.expect("every start ran"))
-                .collect()
-        };
+        let runs = self.optimise_starts(&starts, &uniform, observer);
         let feasible = |r: &StartRun| r.violation <= 1e-6;
         let best = runs
             .iter()

@@ -1,0 +1,220 @@
+//! The path optimisation of one start (the sharpness continuation, then equilibrium tracking),
+//! and several starts on parallel threads.
+
+use super::observer::{PlanObserver, Progress};
+use super::{Planner, spec};
+use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
+
+/// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
+pub(super) fn noise(seed: u64, n: usize) -> Vec<f64> {
+    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            let v = s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+            2.0 * (v as f64 / (1u64 << 53) as f64) - 1.0
+        })
+        .collect()
+}
+
+/// What the multiplier-method calls of one start have produced so far.
+pub(super) struct Tally {
+    pub(super) lambda: Option<Vec<f64>>,
+    pub(super) status: AlStatus,
+    pub(super) violation: f64,
+    pub(super) evaluations: usize,
+}
+
+impl Tally {
+    /// Takes in one call's outcome; true when it failed numerically (nothing more to do).
+    pub(super) fn absorb(&mut self, out: crate::optim::AlOutcome) -> bool {
+        self.evaluations += out.evaluations;
+        self.status = out.status;
+        self.violation = out.max_violation;
+        self.lambda = Some(out.lambda);
+        self.status == AlStatus::NumericalFailure
+    }
+}
+
+#[derive(Clone)]
+pub(super) struct StartRun {
+    pub(super) z: Vec<f64>,
+    pub(super) status: AlStatus,
+    pub(super) violation: f64,
+    pub(super) sampled_max: f64,
+    pub(super) evaluations: usize,
+    pub(super) tracking_rounds: usize,
+}
+
+impl Planner {
+    /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
+    /// `sink` each outer iteration's progress and worst sampled shape as it happens.
+    pub(super) fn optimise_from(
+        &self,
+        start: usize,
+        z0: Vec<f64>,
+        ks: &[f64],
+        first_stage: usize,
+        sink: &mut dyn FnMut(Progress, Vec<f64>),
+    ) -> StartRun {
+        let mut p = self.minimax_problem_at(ks.to_vec());
+        let unit = self.base.model.rod.energy_unit();
+        let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
+        // Energy scale of the sharpness: the straight path's largest sampled energy.
+        let zero = vec![0.0; p.path.n_vars()];
+        crate::optim::Nlp::values(&mut p, &zero, &mut c);
+        let u_ref = p
+            .energies()
+            .iter()
+            .copied()
+            .fold(0.0_f64, f64::max)
+            .max(1e-3);
+        let mut tally = Tally {
+            lambda: None,
+            status: AlStatus::IterationLimit,
+            violation: f64::INFINITY,
+            evaluations: 0,
+        };
+        let al = AlOptions {
+            feasibility_tol: 1e-6,
+            optimality_tol: 1e-5,
+            rho_initial: 1e2,
+            rho_max: 1e8,
+            max_outer: 30,
+            max_inner: 300,
+            active_tol: 1e-7,
+            second_order: self.options.optimiser == spec::Optimiser::Newton,
+            max_step: f64::INFINITY,
+            newton_multipliers: false,
+        };
+        let mut z = z0;
+        for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
+            p.beta = b / u_ref;
+            let out = {
+                let pp = &mut p;
+                let sink = &mut *sink;
+                let mut cbuf = vec![0.0; crate::optim::Nlp::m(pp)];
+                let ks = pp.ks.clone();
+                let beta = pp.beta;
+                let mw = pp.mean_weight;
+                // The observer needs the sampled energies at the iterate: re-evaluate a cheap
+                // copy of the problem.
+                let mut probe = self.minimax_problem_at(ks.clone());
+                probe.beta = beta;
+                probe.mean_weight = mw;
+                augmented_lagrangian_observed(pp, &mut z, tally.lambda.as_deref(), al, &mut |it| {
+                    let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
+                    let u = probe.energies();
+                    let (j, &umax) = u
+                        .iter()
+                        .enumerate()
+                        .max_by(|a, b| a.1.total_cmp(b.1))
+                        .expect("samples");
+                    let mean = u.iter().sum::<f64>() / u.len() as f64;
+                    sink(
+                        Progress {
+                            start,
+                            stage,
+                            outer: it.outer,
+                            smoothed_max: (f - mw * mean) * unit,
+                            sampled_max: umax * unit,
+                            k_worst: ks[j],
+                            violation: it.violation,
+                            rho: it.rho,
+                        },
+                        probe.sampled()[j].clone(),
+                    );
+                })
+            };
+            if tally.absorb(out) {
+                break;
+            }
+        }
+        // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
+        // produces (see the README for why the paper's objective alone does not).
+        let tracking_rounds = if tally.status != AlStatus::NumericalFailure {
+            self.track(&mut p, &mut z, &mut tally, al)
+        } else {
+            0
+        };
+        crate::optim::Nlp::values(&mut p, &z, &mut c);
+        let sampled_max = p
+            .energies()
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+            * unit;
+        StartRun {
+            z,
+            status: tally.status,
+            violation: tally.violation,
+            sampled_max,
+            evaluations: tally.evaluations,
+            tracking_rounds,
+        }
+    }
+
+    /// Optimises from each of `starts` (perturbations of the straight-line path) on the samples
+    /// `ks`, on parallel threads when there are several, telling `observer` their progress as
+    /// it happens.
+    pub(super) fn optimise_starts(
+        &self,
+        starts: &[Vec<f64>],
+        uniform: &[f64],
+        observer: &mut dyn PlanObserver,
+    ) -> Vec<StartRun> {
+        let model = &self.base.model;
+        if starts.len() == 1 {
+            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
+            vec![self.optimise_from(0, starts[0].clone(), uniform, 0, &mut sink)]
+        } else {
+            let workers = std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(starts.len());
+            let mut results: Vec<Option<StartRun>> = (0..starts.len()).map(|_| None).collect();
+            // The starts report their progress through a channel, which this thread passes on
+            // to the observer while they run.
+            let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
+            std::thread::scope(|sc| {
+                let chunks: Vec<Vec<usize>> = (0..workers)
+                    .map(|w| (w..starts.len()).step_by(workers).collect())
+                    .collect();
+                let handles: Vec<_> = chunks
+                    .into_iter()
+                    .map(|idx| {
+                        let starts = &starts;
+                        let uniform = &uniform;
+                        let tx = tx.clone();
+                        sc.spawn(move || {
+                            let mut sink = |p: Progress, w: Vec<f64>| {
+                                // The receiver outlives every start.
+                                let _ = tx.send((p, w));
+                            };
+                            idx.into_iter()
+                                .map(|i| {
+                                    let z0 = starts[i].clone();
+                                    (i, self.optimise_from(i, z0, uniform, 0, &mut sink))
+                                })
+                                .collect::<Vec<_>>()
+                        })
+                    })
+                    .collect();
+                drop(tx);
+                for (p, w) in rx {
+                    observer.progress(model, &p, &w);
+                }
+                for h in handles {
+                    for (i, r) in h.join().expect("optimiser thread") {
+                        results[i] = Some(r);
+                    }
+                }
+            });
+            results
+                .into_iter()
+                .map(|r| r.expect("every start ran"))
+                .collect()
+        }
+    }
+}

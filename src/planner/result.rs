@@ -1,0 +1,89 @@
+//! What a plan run reports: its status, the chosen plan's numbers, every start, the replay and
+//! the timings.
+
+use super::replay::Replay;
+use super::verify::Verification;
+use crate::optim::AlStatus;
+use serde::Serialize;
+
+/// How a plan ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanStatus {
+    /// The optimiser converged and the verification grid is collision-free.
+    Planned,
+    /// The verification grid finds a collision (e.g. tunnelling between samples).
+    Collision,
+    /// The optimiser did not converge (the path may still be collision-free).
+    NotConverged,
+}
+
+/// Summary of one optimiser start.
+#[derive(Clone, Debug, Serialize)]
+pub struct StartSummary {
+    /// Start index.
+    pub start: usize,
+    /// Final optimiser status.
+    pub status: AlStatus,
+    /// Largest sampled energy (case units).
+    pub sampled_u_max: f64,
+    /// Constraint violation (dimensionless).
+    pub violation: f64,
+    /// Objective evaluations.
+    pub evaluations: usize,
+    /// Equilibrium-tracking rounds run (at most `equilibrium_rounds`; fewer when the sampled
+    /// shapes already lie on their equilibria or a round stops bringing them closer).
+    pub tracking_rounds: usize,
+}
+
+/// The outcome of [`Planner::run`].
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanResult {
+    /// Overall status.
+    pub status: PlanStatus,
+    /// Optimiser status of the chosen start.
+    pub optimiser: AlStatus,
+    /// True `U_max` of the plan on the verification grid (case units).
+    pub u_max: f64,
+    /// `k` where it occurs.
+    pub k_at_u_max: f64,
+    /// The largest energy on the optimiser's own `k` samples for the plan (case units): the
+    /// value it minimised, which `u_max` exceeds where a peak falls between samples.
+    pub sampled_u_max: f64,
+    /// `U_max` of the straight-line path `c = 0` (case units).
+    pub u_max_straight: f64,
+    /// Smallest obstacle clearance on the verification grid, optimal path (case units).
+    pub min_clearance: Option<f64>,
+    /// Smallest obstacle clearance of the straight-line path (case units).
+    pub min_clearance_straight: Option<f64>,
+    /// Largest violation of the optimiser's sampled constraints (dimensionless).
+    pub violation: f64,
+    /// Verification details of the plan.
+    pub verification: Verification,
+    /// Every start.
+    pub starts: Vec<StartSummary>,
+    /// The start the plan comes from (the lowest sampled `U_max` among the feasible ones).
+    pub chosen_start: usize,
+    /// Path vectors `cᵢ` (coefficient space).
+    pub path: Vec<Vec<f64>>,
+    /// The unknowns `z`.
+    #[serde(skip)]
+    pub z: Vec<f64>,
+    /// Feasibility replay.
+    pub replay: Replay,
+    /// `k` samples added where the verification grid found tunnelling or a missed energy peak.
+    pub added_samples: Vec<f64>,
+    /// Seconds spent planning (optimise + verify) and replaying.
+    pub timing_s: Timing,
+}
+
+/// Wall-clock times.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Timing {
+    /// Start and goal solves.
+    pub endpoints: f64,
+    /// Optimisation and verification.
+    pub plan: f64,
+    /// Replay.
+    pub replay: f64,
+}

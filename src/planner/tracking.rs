@@ -1,0 +1,87 @@
+//! Equilibrium tracking: after the sharpness stages, the planner replays its own samples (the
+//! equilibria their end poses produce) and pulls each sampled shape onto that equilibrium by a
+//! term in the objective, re-optimising, round after round while it helps (see the README).
+
+use super::minimax::MinimaxProblem;
+use super::optimise::Tally;
+use super::{Planner, replay};
+use crate::constraints::ObstacleConstraint;
+use crate::optim::{AlOptions, augmented_lagrangian_observed};
+
+/// Equilibrium tracking ends once the sampled shapes lie within this fraction of the coincidence
+/// tolerance from the equilibria of their end poses.
+const TRACK_DONE: f64 = 0.1;
+
+/// Equilibrium tracking ends after a round that brings the sampled shapes less than this
+/// fraction closer to their equilibria.
+const TRACK_PROGRESS: f64 = 0.1;
+
+impl Planner {
+    /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
+    /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran.
+    pub(super) fn track(
+        &self,
+        p: &mut MinimaxProblem,
+        z: &mut [f64],
+        tally: &mut Tally,
+        al: AlOptions,
+    ) -> usize {
+        if self.options.track_weight <= 0.0 {
+            return 0;
+        }
+        let mut tracking_rounds = 0;
+        p.track_weight = self.options.track_weight;
+        // Targets keep the optimiser's safety margin from obstacles.
+        let mut inflated = self.base.clone();
+        for con in inflated.constraints.iter_mut() {
+            if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
+                let mut o = ob.clone();
+                o.clearance += self.options.safety;
+                *con = Box::new(o);
+            }
+        }
+        // Rounds stop early when the sampled shapes already lie within `TRACK_DONE` of the
+        // coincidence tolerance from their equilibria, or when a round brought them less
+        // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
+        let done = TRACK_DONE * self.options.tolerance;
+        let mut dev_prev = f64::INFINITY;
+        for _ in 0..self.options.track_rounds {
+            let targets = replay::equilibria(
+                &inflated,
+                &self.start,
+                &p.path,
+                z,
+                &p.ks,
+                &self.static_options,
+            );
+            let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
+                old.iter()
+                    .zip(&targets)
+                    .flat_map(|(a, b)| a.iter().zip(b))
+                    .map(|(u, v)| (0..3).map(|i| (u[i] - v[i]).abs()).fold(0.0, f64::max))
+                    .fold(0.0, f64::max)
+            });
+            // The replay's deviation, estimated on the samples.
+            let dev = p.distance_to(z, &targets);
+            p.targets = Some(targets);
+            // Targets that no longer move: the path already sits on its equilibria.
+            if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
+                break;
+            }
+            dev_prev = dev;
+            tracking_rounds += 1;
+            // Newton steps here in either mode: the sharpness stages have chosen the route,
+            // and tracking only pulls its shapes onto their equilibria.
+            let al_t = AlOptions {
+                second_order: true,
+                ..al
+            };
+            let out =
+                augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_| {});
+            if tally.absorb(out) {
+                break;
+            }
+        }
+        tracking_rounds
+    }
+}
