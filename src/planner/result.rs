@@ -36,7 +36,7 @@ pub struct StartSummary {
     pub tracking_rounds: usize,
 }
 
-/// The outcome of [`Planner::run`].
+/// The outcome of [`super::Planner::run`].
 #[derive(Clone, Debug, Serialize)]
 pub struct PlanResult {
     /// Overall status.
