@@ -459,6 +459,18 @@ fn bad_planning_inputs_name_the_field() {
             ),
             "plan.energy_gap_tolerance",
         ),
+        (
+            plan_text(
+                r#"{ "x": 0.3, "z": 0.9 }"#,
+                r#"{ "x": -0.3, "z": 0.9 }"#,
+                "",
+            )
+            .replace(
+                r#""k_samples": 21"#,
+                r#""k_samples": 21, "equilibrium_stop": 1.5"#,
+            ),
+            "plan.equilibrium_stop",
+        ),
     ];
     for (text, field) in cases {
         let c = case::parse(&text, Path::new("bad.json")).unwrap();
@@ -695,6 +707,25 @@ fn bar_case_3d_coincides() {
         let at0 = |o: usize| model.layout.basis.eval(&a[o..o + nb], 0.0);
         assert!((at0(op) + at0(os)).abs() < 1e-9, "k = {k}");
     }
+}
+
+/// `equilibrium_stop: 0` turns off the stop at a tenth of the tolerance: the bar case then
+/// runs tracking rounds until they stop helping, and its replay follows the plan more closely
+/// than the default plan's, which runs none.
+#[test]
+fn bar_case_tracks_when_asked() {
+    let name = "plan_cable_under_bar.json";
+    let c = shipped_variant(name, |v| v["plan"]["equilibrium_stop"] = 0.0.into());
+    let r = Planner::from_case(&c).unwrap().run(&mut Silent);
+    assert_3d_plan_coincides(name, &r, Some(0.05));
+    assert!(r.starts[0].tracking_rounds >= 1);
+    let default = &bar().1;
+    assert!(
+        r.replay.max_deviation_over_l < default.replay.max_deviation_over_l,
+        "{} vs {}",
+        r.replay.max_deviation_over_l,
+        default.replay.max_deviation_over_l
+    );
 }
 
 /// A cable routed around a pillar its straight-line path runs through (by more than 0.1 L).

@@ -35,9 +35,14 @@ pub struct PlanSpec {
     /// Weight of the equilibrium-tracking term (0 = the paper's objective alone).
     #[serde(default = "d_track")]
     pub equilibrium_weight: f64,
-    /// Rounds of equilibrium tracking (replay at the samples, then re-optimise).
+    /// Most rounds of equilibrium tracking (replay at the samples, then re-optimise).
     #[serde(default = "d_rounds")]
     pub equilibrium_rounds: usize,
+    /// Tracking stops once the sampled shapes lie within this fraction of
+    /// `coincide_tolerance` from their equilibria (0: only the rounds' budget and their
+    /// progress stop it).
+    #[serde(default = "d_track_stop")]
+    pub equilibrium_stop: f64,
     /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
     #[serde(default = "d_sharp")]
     pub sharpness: Vec<f64>,
@@ -113,6 +118,9 @@ fn d_track() -> f64 {
 }
 fn d_rounds() -> usize {
     3
+}
+fn d_track_stop() -> f64 {
+    0.1
 }
 fn d_sharp() -> Vec<f64> {
     // Two decades in the R5 preferred-number steps (×≈1.6 per stage): a continuation this fine
@@ -207,8 +215,10 @@ pub struct PlanOptions {
     pub mean_weight: f64,
     /// Equilibrium-tracking weight.
     pub track_weight: f64,
-    /// Equilibrium-tracking rounds.
+    /// Most equilibrium-tracking rounds.
     pub track_rounds: usize,
+    /// Tracking stops below this fraction of the coincidence tolerance.
+    pub track_stop: f64,
     /// Sharpness stages.
     pub sharpness: Vec<f64>,
     /// Number of starts.
@@ -347,6 +357,13 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
     if spec.equilibrium_rounds > 50 {
         return Err(v.err("plan.equilibrium_rounds", "must be at most 50"));
     }
+    let stop = v.finite("plan.equilibrium_stop", spec.equilibrium_stop)?;
+    if !(0.0..1.0).contains(&stop) {
+        return Err(v.err(
+            "plan.equilibrium_stop",
+            format!("must be in [0, 1) (a fraction of coincide_tolerance), got {stop}"),
+        ));
+    }
     if spec.sharpness.is_empty() {
         return Err(v.err("plan.sharpness", "needs at least one value"));
     }
@@ -383,6 +400,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         mean_weight: spec.mean_weight,
         track_weight: spec.equilibrium_weight,
         track_rounds: spec.equilibrium_rounds,
+        track_stop: stop,
         sharpness: spec.sharpness,
         starts: spec.starts,
         seed: spec.seed,

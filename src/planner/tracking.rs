@@ -8,10 +8,6 @@ use super::{Planner, replay};
 use crate::constraints::ObstacleConstraint;
 use crate::optim::{AlOptions, augmented_lagrangian_observed};
 
-/// Equilibrium tracking ends once the sampled shapes lie within this fraction of the coincidence
-/// tolerance from the equilibria of their end poses.
-const TRACK_DONE: f64 = 0.1;
-
 /// Equilibrium tracking ends after a round that brings the sampled shapes less than this
 /// fraction closer to their equilibria.
 const TRACK_PROGRESS: f64 = 0.1;
@@ -40,10 +36,10 @@ impl Planner {
                 *con = Box::new(o);
             }
         }
-        // Rounds stop early when the sampled shapes already lie within `TRACK_DONE` of the
-        // coincidence tolerance from their equilibria, or when a round brought them less
+        // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of
+        // the coincidence tolerance from their equilibria, or when a round brought them less
         // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
-        let done = TRACK_DONE * self.options.tolerance;
+        let done = self.options.track_stop * self.options.tolerance;
         let mut dev_prev = f64::INFINITY;
         for _ in 0..self.options.track_rounds {
             let targets = replay::equilibria(
