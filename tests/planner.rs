@@ -408,16 +408,20 @@ fn plan_keeps_the_rod_from_crossing_itself() {
 /// Bad planning inputs are errors that name the field.
 #[test]
 fn bad_planning_inputs_name_the_field() {
+    // A swing between two poses with one more `plan` field.
+    let swing_with = |field: &str| {
+        plan_text(
+            r#"{ "x": 0.3, "z": 0.9 }"#,
+            r#"{ "x": -0.3, "z": 0.9 }"#,
+            "",
+        )
+        .replace(
+            r#""k_samples": 21"#,
+            &format!(r#""k_samples": 21, {field}"#),
+        )
+    };
     let cases = [
-        (
-            plan_text(
-                r#"{ "x": 0.3, "z": 0.9 }"#,
-                r#"{ "x": -0.3, "z": 0.9 }"#,
-                "",
-            )
-            .replace(r#""k_samples": 21"#, r#""path_terms": 0"#),
-            "plan.path_terms",
-        ),
+        (swing_with(r#""path_terms": 0"#), "plan.path_terms"),
         (
             plan_text(r#"{ "x": 0.3, "z": 0.9 }"#, r#"{ "x": 1.5, "z": 0.9 }"#, ""),
             "plan.goal",
@@ -448,27 +452,11 @@ fn bad_planning_inputs_name_the_field() {
             "plan",
         ),
         (
-            plan_text(
-                r#"{ "x": 0.3, "z": 0.9 }"#,
-                r#"{ "x": -0.3, "z": 0.9 }"#,
-                "",
-            )
-            .replace(
-                r#""k_samples": 21"#,
-                r#""k_samples": 21, "energy_gap_tolerance": -0.1"#,
-            ),
+            swing_with(r#""energy_gap_tolerance": -0.1"#),
             "plan.energy_gap_tolerance",
         ),
         (
-            plan_text(
-                r#"{ "x": 0.3, "z": 0.9 }"#,
-                r#"{ "x": -0.3, "z": 0.9 }"#,
-                "",
-            )
-            .replace(
-                r#""k_samples": 21"#,
-                r#""k_samples": 21, "equilibrium_stop": 1.5"#,
-            ),
+            swing_with(r#""equilibrium_stop": 1.5"#),
             "plan.equilibrium_stop",
         ),
     ];

@@ -166,10 +166,7 @@ impl MinimaxProblem {
         for (&k, tj) in self.ks.iter().zip(targets) {
             self.path.shape_at(z, k, &mut a);
             self.model.evaluate_into(&a, &mut shape);
-            for (x, xb) in shape.positions.iter().zip(tj) {
-                let d2: f64 = (0..3).map(|i| (x[i] - xb[i]).powi(2)).sum();
-                worst = worst.max(d2.sqrt());
-            }
+            worst = worst.max(crate::planner::replay::max_distance(&shape.positions, tj));
         }
         worst
     }

@@ -84,7 +84,7 @@ struct State {
 }
 
 /// Largest distance between corresponding boundary points (dimensionless).
-fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(crate) fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(p, q)| {
