@@ -15,6 +15,13 @@ fn run(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Asserts that the JSON object `v` (at `path`, for the message) has every one of `keys`.
+fn assert_has_keys(v: &serde_json::Value, path: &str, keys: &[&str]) {
+    for key in keys {
+        assert!(v.get(key).is_some(), "missing {path}{key}");
+    }
+}
+
 const GOOD_ROD: &str = r#""rod": {"length": 100.0, "flexural_rigidity": 1.0}"#;
 
 /// (label, case text, text the error must contain)
@@ -290,7 +297,7 @@ fn shipped_pinned_case_prints_documented_json() {
     ]);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    for key in [
+    let keys = [
         "status",
         "energy",
         "reactions",
@@ -298,9 +305,8 @@ fn shipped_pinned_case_prints_documented_json() {
         "stable",
         "end_pose",
         "timing_s",
-    ] {
-        assert!(v.get(key).is_some(), "missing {key}");
-    }
+    ];
+    assert_has_keys(&v, "", &keys);
     for key in [
         "total",
         "flexural",
@@ -408,7 +414,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     let (code, out, err) = run(&["plan", pillar, "--json", "--log-dir", logs_s]);
     assert_eq!(code, 0, "{err}");
     let v = json(&out);
-    for key in [
+    let keys = [
         "status",
         "u_max",
         "u_max_straight",
@@ -417,18 +423,16 @@ fn plan_prints_documented_json_and_exit_codes() {
         "replay",
         "mcap",
         "timing_s",
-    ] {
-        assert!(v.get(key).is_some(), "missing {key}");
-    }
-    for key in [
+    ];
+    assert_has_keys(&v, "", &keys);
+    let keys = [
         "max_deviation_over_l",
         "k_at_max_deviation",
         "u_max",
         "all_stable",
         "coincide",
-    ] {
-        assert!(v["replay"].get(key).is_some(), "missing replay.{key}");
-    }
+    ];
+    assert_has_keys(&v["replay"], "replay.", &keys);
     assert!(v["timing_s"]["plan"].as_f64().unwrap() > 0.0);
     assert!(v["timing_s"]["replay"].as_f64().unwrap() > 0.0);
     assert_eq!(v["status"], "planned");
