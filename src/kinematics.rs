@@ -10,7 +10,8 @@ use crate::model::Model;
 pub struct Shape {
     /// `θ` at nodes.
     pub th: Vec<f64>,
-    /// `dθ/dt` at nodes.
+    /// `dθ/dt` at nodes (empty for a weightless planar rod: its energy is the constant
+    /// quadratic form of the model, and nothing else reads the curvature).
     pub dth: Vec<f64>,
     /// `φ` at nodes (zero for planar rods).
     pub ph: Vec<f64>,
@@ -37,10 +38,11 @@ impl Model {
         let ap = lay.field(a, Field::Phi);
         let aps = lay.field(a, Field::Psi);
         let ae = lay.field(a, Field::Eps);
+        let curvature = self.energy_roots.is_empty();
         // Fields written below only need the right length; the others are zero.
         for (v, present) in [
             (&mut shape.th, true),
-            (&mut shape.dth, true),
+            (&mut shape.dth, curvature),
             (&mut shape.sth, true),
             (&mut shape.cth, true),
             (&mut shape.ph, ap.is_some()),
@@ -57,15 +59,23 @@ impl Model {
         }
         // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
         let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
-            out.iter_mut().for_each(|v| *v = 0.0);
-            for (&ci, row) in c.iter().zip(m.chunks_exact(nn)) {
+            let mut rows = c.iter().zip(m.chunks_exact(nn));
+            let Some((&c0, row0)) = rows.next() else {
+                return out.iter_mut().for_each(|v| *v = 0.0);
+            };
+            for (v, &r) in out.iter_mut().zip(row0) {
+                *v = c0 * r;
+            }
+            for (&ci, row) in rows {
                 for (v, &r) in out.iter_mut().zip(row) {
                     *v += ci * r;
                 }
             }
         };
         rows(at, &self.e_rows, &mut shape.th);
-        rows(at, &self.de_rows, &mut shape.dth);
+        if curvature {
+            rows(at, &self.de_rows, &mut shape.dth);
+        }
         crate::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
         if let Some(ap) = ap {
             rows(ap, &self.e_rows, &mut shape.ph);

@@ -160,14 +160,20 @@ impl Obstacle {
         [g[0] / n, g[1] / n, g[2] / n]
     }
 
-    /// Signed distance only (no normal), for the on-surface fallback.
-    fn signed_distance_value(&self, p: [f64; 3]) -> f64 {
+    /// Signed distance only (no normal): the value of [`Obstacle::signed_distance`].
+    pub fn signed_distance_value(&self, p: [f64; 3]) -> f64 {
         let pl = self.to_local(v3(p));
         match self.project_local(pl) {
             None => self.signed_distance(p).0,
             Some(proj) => {
                 let d = (pl - proj.point).length();
-                if proj.is_inside { -d } else { d }
+                if d < 1e-14 {
+                    0.0
+                } else if proj.is_inside {
+                    -d
+                } else {
+                    d
+                }
             }
         }
     }

@@ -190,7 +190,9 @@ fn weightless_planar_energy_is_its_quadratic_form() {
         }
         let (mut flex_q, mut ext_q) = (0.0, 0.0);
         for (q, (&t, &w)) in m.mesh.nodes.iter().zip(&m.mesh.weights).enumerate() {
-            flex_q += 0.5 * w * r.flexural.at(t) / rf * shape.dth[q] * shape.dth[q];
+            layout.basis.derivatives(t, &mut d);
+            let dth: f64 = th.iter().zip(&d).map(|(c, e)| c * e).sum();
+            flex_q += 0.5 * w * r.flexural.at(t) / rf * dth * dth;
             if ext {
                 let e = shape.eps[q];
                 ext_q += 0.5 * w * r.extensional.unwrap().at(t) * l * l / rf * e * e;

@@ -36,7 +36,7 @@ impl Constraint for ObstacleConstraint {
     fn values(&self, _m: &Model, _a: &[f64], shape: &Shape, out: &mut [f64]) {
         for (o, &b) in out.iter_mut().zip(&self.samples) {
             let x = shape.positions[b].map(|v| v * self.length);
-            let (d, _) = self.obstacle.signed_distance(x);
+            let d = self.obstacle.signed_distance_value(x);
             *o = self.clearance - d / self.length;
         }
     }
