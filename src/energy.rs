@@ -76,6 +76,18 @@ impl Model {
         objective: Objective,
         grad: Option<&mut [f64]>,
     ) -> EnergyTerms {
+        energy_terms(self, a, shape, objective, grad)
+    }
+
+    /// [`Model::energy`]'s loops (compiled twice, see [`crate::wide`]).
+    #[inline(always)]
+    fn energy_body(
+        &self,
+        a: &[f64],
+        shape: &Shape,
+        objective: Objective,
+        grad: Option<&mut [f64]>,
+    ) -> EnergyTerms {
         let lay = &self.layout;
         let nb = self.nb();
         let op = lay.offset(Field::Phi);
@@ -164,6 +176,7 @@ impl Model {
     /// Hessian `K`, as the sum of squares `½ Σ_r (R_r · a)²` of its square-root rows, and the
     /// gradient `K a = Σ_r (R_r · a) R_r` added to `grad`: the node sums' value in `n²`
     /// operations instead of `nodes · n`.
+    #[inline(always)]
     fn quadratic_terms(&self, a: &[f64], t: &mut EnergyTerms, grad: Option<&mut [f64]>) {
         let mut grad = grad;
         for r in &self.energy_roots {
@@ -195,4 +208,14 @@ impl Model {
         self.energy(a, shape, objective, Some(grad))
             .value(objective)
     }
+}
+
+crate::wide::dispatch! {
+    fn energy_terms(
+        m: &Model,
+        a: &[f64],
+        shape: &Shape,
+        objective: Objective,
+        grad: Option<&mut [f64]>,
+    ) -> EnergyTerms => Model::energy_body
 }

@@ -40,6 +40,7 @@ fn sources(model: &Model) -> [Option<(usize, bool)>; 6] {
 impl Model {
     /// Adds `Σ_q Bqᵀ Hq Bq` to the row-major `n×n` matrix `h`, where `local(q, hq)` fills the
     /// upper triangle of node `q`'s 6×6 local Hessian (entries of absent fields are ignored).
+    #[inline(always)]
     fn assemble_local(&self, h: &mut [f64], mut local: impl FnMut(usize, &mut [[f64; 6]; 6])) {
         let n = self.n();
         let nb = self.nb();
@@ -105,6 +106,12 @@ impl Model {
         scale: f64,
         h: &mut [f64],
     ) {
+        energy_hessian(self, shape, objective, scale, h);
+    }
+
+    /// [`Model::add_energy_hessian`]'s loops (compiled twice, see [`crate::wide`]).
+    #[inline(always)]
+    fn energy_hessian_body(&self, shape: &Shape, objective: Objective, scale: f64, h: &mut [f64]) {
         let spatial = self.layout.spatial;
         for (hv, kv) in h.iter_mut().zip(&self.constant_hessian) {
             *hv += scale * kv;
@@ -151,6 +158,12 @@ impl Model {
 
     /// Adds `Σ_b v[b] · ∂²x(b)/∂a²` to `h` (row-major `n×n`), one vector per mesh boundary.
     pub fn add_positions_hessian(&self, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) {
+        positions_hessian(self, shape, v, h);
+    }
+
+    /// [`Model::add_positions_hessian`]'s loops (compiled twice, see [`crate::wide`]).
+    #[inline(always)]
+    fn positions_hessian_body(&self, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) {
         // Suffix sums: a node of panel j enters every position after it.
         let panels = self.mesh.panels();
         let mut suffix = vec![[0.0; 3]; panels];
@@ -412,4 +425,12 @@ mod tests {
             assert_close(&h, &expect);
         }
     }
+}
+
+crate::wide::dispatch! {
+    fn positions_hessian(m: &Model, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) => Model::positions_hessian_body
+}
+
+crate::wide::dispatch! {
+    fn energy_hessian(m: &Model, shape: &Shape, objective: Objective, scale: f64, h: &mut [f64]) => Model::energy_hessian_body
 }

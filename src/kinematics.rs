@@ -32,78 +32,7 @@ pub struct Shape {
 impl Model {
     /// Evaluates the shape of coefficients `a` into `shape` (reusing its buffers).
     pub fn evaluate_into(&self, a: &[f64], shape: &mut Shape) {
-        let nn = self.nodes();
-        let lay = &self.layout;
-        let at = lay.field(a, Field::Theta).expect("theta is always present");
-        let ap = lay.field(a, Field::Phi);
-        let aps = lay.field(a, Field::Psi);
-        let ae = lay.field(a, Field::Eps);
-        let curvature = self.energy_roots.is_empty();
-        // Fields written below only need the right length; the others are zero.
-        for (v, present) in [
-            (&mut shape.th, true),
-            (&mut shape.dth, curvature),
-            (&mut shape.sth, true),
-            (&mut shape.cth, true),
-            (&mut shape.ph, ap.is_some()),
-            (&mut shape.dph, ap.is_some()),
-            (&mut shape.sph, ap.is_some()),
-            (&mut shape.cph, true),
-            (&mut shape.dps, aps.is_some()),
-            (&mut shape.eps, ae.is_some()),
-        ] {
-            if !present {
-                v.clear();
-            }
-            v.resize(nn, 0.0);
-        }
-        // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
-        let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
-            let mut rows = c.iter().zip(m.chunks_exact(nn));
-            let Some((&c0, row0)) = rows.next() else {
-                return out.iter_mut().for_each(|v| *v = 0.0);
-            };
-            for (v, &r) in out.iter_mut().zip(row0) {
-                *v = c0 * r;
-            }
-            for (&ci, row) in rows {
-                for (v, &r) in out.iter_mut().zip(row) {
-                    *v += ci * r;
-                }
-            }
-        };
-        rows(at, &self.e_rows, &mut shape.th);
-        if curvature {
-            rows(at, &self.de_rows, &mut shape.dth);
-        }
-        crate::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
-        if let Some(ap) = ap {
-            rows(ap, &self.e_rows, &mut shape.ph);
-            rows(ap, &self.de_rows, &mut shape.dph);
-            crate::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
-        } else {
-            shape.cph.iter_mut().for_each(|v| *v = 1.0);
-        }
-        if let Some(aps) = aps {
-            rows(aps, &self.de_rows, &mut shape.dps);
-        }
-        if let Some(ae) = ae {
-            rows(ae, &self.e_rows, &mut shape.eps);
-        }
-        let base = self.base_position(a);
-        shape.positions.clear();
-        shape.positions.push(base);
-        let mut x = base;
-        let ps = &self.mesh.panel_start;
-        for j in 0..self.mesh.panels() {
-            for q in ps[j]..ps[j + 1] {
-                let w = self.mesh.weights[q] * (1.0 + shape.eps[q]);
-                x[0] += w * shape.sth[q] * shape.cph[q];
-                x[1] += w * shape.sth[q] * shape.sph[q];
-                x[2] += w * shape.cth[q];
-            }
-            shape.positions.push(x);
-        }
+        evaluate_nodes(self, a, shape);
     }
 
     /// Evaluates the shape of coefficients `a`.
@@ -128,6 +57,12 @@ impl Model {
     /// (dimensionless). One backward pass over the nodes: a node's tangent enters every
     /// position after it, so it sees the suffix sum of the `v`.
     pub fn add_positions_vjp(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
+        positions_vjp(self, shape, v, grad);
+    }
+
+    /// [`Model::add_positions_vjp`]'s loops (compiled twice, see [`crate::wide`]).
+    #[inline(always)]
+    fn positions_vjp_body(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
         let lay = &self.layout;
         let nb = self.nb();
         let ot = 0;
@@ -226,6 +161,103 @@ impl Model {
             x[2] += w * th.cos();
         }
         x
+    }
+}
+
+crate::wide::dispatch! {
+    fn evaluate_nodes(m: &Model, a: &[f64], shape: &mut Shape) => evaluate_nodes_body
+}
+
+crate::wide::dispatch! {
+    fn positions_vjp(m: &Model, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) => Model::positions_vjp_body
+}
+
+/// [`Model::evaluate_into`]'s loops (compiled twice, see [`crate::wide`]).
+#[inline(always)]
+fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
+    let nn = m.nodes();
+    let lay = &m.layout;
+    let at = lay.field(a, Field::Theta).expect("theta is always present");
+    let ap = lay.field(a, Field::Phi);
+    let aps = lay.field(a, Field::Psi);
+    let ae = lay.field(a, Field::Eps);
+    let curvature = m.energy_roots.is_empty();
+    // Fields written below only need the right length; the others are zero.
+    for (v, present) in [
+        (&mut shape.th, true),
+        (&mut shape.dth, curvature),
+        (&mut shape.sth, true),
+        (&mut shape.cth, true),
+        (&mut shape.ph, ap.is_some()),
+        (&mut shape.dph, ap.is_some()),
+        (&mut shape.sph, ap.is_some()),
+        (&mut shape.cph, true),
+        (&mut shape.dps, aps.is_some()),
+        (&mut shape.eps, ae.is_some()),
+    ] {
+        if !present {
+            v.clear();
+        }
+        v.resize(nn, 0.0);
+    }
+    // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
+    let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
+        let mut rows = c.iter().zip(m.chunks_exact(nn));
+        let Some((&c0, row0)) = rows.next() else {
+            return out.iter_mut().for_each(|v| *v = 0.0);
+        };
+        for (v, &r) in out.iter_mut().zip(row0) {
+            *v = c0 * r;
+        }
+        for (&ci, row) in rows {
+            for (v, &r) in out.iter_mut().zip(row) {
+                *v += ci * r;
+            }
+        }
+    };
+    rows(at, &m.e_rows, &mut shape.th);
+    if curvature {
+        rows(at, &m.de_rows, &mut shape.dth);
+    }
+    crate::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
+    if let Some(ap) = ap {
+        rows(ap, &m.e_rows, &mut shape.ph);
+        rows(ap, &m.de_rows, &mut shape.dph);
+        crate::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
+    } else {
+        shape.cph.iter_mut().for_each(|v| *v = 1.0);
+    }
+    if let Some(aps) = aps {
+        rows(aps, &m.de_rows, &mut shape.dps);
+    }
+    if let Some(ae) = ae {
+        rows(ae, &m.e_rows, &mut shape.eps);
+    }
+    let base = m.base_position(a);
+    shape.positions.clear();
+    shape.positions.push(base);
+    let mut x = base;
+    let ps = &m.mesh.panel_start;
+    if ap.is_none() && ae.is_none() {
+        // In the x–z plane, inextensible: the same sums without the zero terms.
+        for j in 0..m.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = m.mesh.weights[q];
+                x[0] += w * shape.sth[q];
+                x[2] += w * shape.cth[q];
+            }
+            shape.positions.push(x);
+        }
+        return;
+    }
+    for j in 0..m.mesh.panels() {
+        for q in ps[j]..ps[j + 1] {
+            let w = m.mesh.weights[q] * (1.0 + shape.eps[q]);
+            x[0] += w * shape.sth[q] * shape.cph[q];
+            x[1] += w * shape.sth[q] * shape.sph[q];
+            x[2] += w * shape.cth[q];
+        }
+        shape.positions.push(x);
     }
 }
 

@@ -36,5 +36,6 @@ pub mod report;
 pub mod rod;
 pub mod statics;
 pub mod trig;
+pub mod wide;
 
 pub use error::Error;

@@ -92,6 +92,7 @@ impl Obstacle {
     }
 
     /// World point `pv` in the obstacle's frame.
+    #[inline(always)]
     fn to_local(&self, pv: Vector) -> Vector {
         if self.rotated {
             self.pose.inverse_transform_point(pv)
@@ -102,6 +103,7 @@ impl Obstacle {
 
     /// Projection of the local point `pl` onto the surface, in the local frame (`None` for a
     /// half-space).
+    #[inline(always)]
     fn project_local(&self, pl: Vector) -> Option<parry3d_f64::query::PointProjection> {
         Some(match &self.shape {
             ObstacleShape::HalfSpace(_) => return None,
@@ -161,6 +163,7 @@ impl Obstacle {
     }
 
     /// Signed distance only (no normal): the value of [`Obstacle::signed_distance`].
+    #[inline(always)]
     pub fn signed_distance_value(&self, p: [f64; 3]) -> f64 {
         let pl = self.to_local(v3(p));
         match self.project_local(pl) {

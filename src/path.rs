@@ -79,6 +79,12 @@ impl DeformationPath {
 
     /// Writes `a(z, k)` into `out`.
     pub fn shape_at(&self, z: &[f64], k: f64, out: &mut [f64]) {
+        shape_at(self, z, k, out);
+    }
+
+    /// [`DeformationPath::shape_at`]'s loops (compiled twice, see [`crate::wide`]).
+    #[inline(always)]
+    fn shape_at_body(&self, z: &[f64], k: f64, out: &mut [f64]) {
         for ((o, &x0), &x1) in out.iter_mut().zip(&self.a0).zip(&self.a1) {
             *o = (1.0 - k) * x0 + k * x1;
         }
@@ -144,4 +150,8 @@ impl DeformationPath {
             }
         }
     }
+}
+
+crate::wide::dispatch! {
+    fn shape_at(p: &DeformationPath, z: &[f64], k: f64, out: &mut [f64]) => DeformationPath::shape_at_body
 }

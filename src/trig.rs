@@ -43,6 +43,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 
 /// `s[i], c[i] = sin x[i], cos x[i]`: without branches when every argument is in range, so
 /// that the loop vectorises.
+#[inline(always)]
 pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
     if x.iter().all(|v| v.abs() < 1e5) {
         for ((&xi, si), ci) in x.iter().zip(s.iter_mut()).zip(c.iter_mut()) {

@@ -34,11 +34,7 @@ impl Constraint for ObstacleConstraint {
         Sense::LessEq
     }
     fn values(&self, _m: &Model, _a: &[f64], shape: &Shape, out: &mut [f64]) {
-        for (o, &b) in out.iter_mut().zip(&self.samples) {
-            let x = shape.positions[b].map(|v| v * self.length);
-            let d = self.obstacle.signed_distance_value(x);
-            *o = self.clearance - d / self.length;
-        }
+        clearances(self, &shape.positions, out);
     }
     fn add_gradient(&self, _m: &Model, _a: &[f64], shape: &Shape, w: &[f64], adj: &mut Adjoint) {
         for (&wi, &b) in w.iter().zip(&self.samples) {
@@ -98,5 +94,19 @@ impl Constraint for ObstacleConstraint {
     }
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+}
+
+crate::wide::dispatch! {
+    fn clearances(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f64]) => clearances_body
+}
+
+/// The rows' values from the positions (compiled twice, see [`crate::wide`]).
+#[inline(always)]
+fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f64]) {
+    for (o, &b) in out.iter_mut().zip(&c.samples) {
+        let x = positions[b].map(|v| v * c.length);
+        let d = c.obstacle.signed_distance_value(x);
+        *o = c.clearance - d / c.length;
     }
 }
