@@ -132,11 +132,25 @@ pub struct OuterIterate<'a> {
 /// boundary where its penalty curvature enters `∇²Φ`.
 const BOUNDARY_BAND: f64 = 1e-9;
 
-/// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier estimates
-/// `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows whose
-/// penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton part
-/// `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
-fn augment(
+crate::wide::dispatch! {
+    /// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier
+    /// estimates `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows
+    /// whose penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton
+    /// part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
+    fn augment(
+        f: f64,
+        c: &[f64],
+        lam: &[f64],
+        rho: f64,
+        senses: &[Sense],
+        y: &mut [f64],
+        s: &mut [f64],
+    ) -> f64 => augment_body
+}
+
+/// [`augment`]'s loop (compiled twice, see [`crate::wide`]).
+#[inline(always)]
+fn augment_body(
     f: f64,
     c: &[f64],
     lam: &[f64],

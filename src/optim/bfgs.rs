@@ -110,9 +110,7 @@ pub fn bfgs(
             if inf_norm(&g) <= opts.grad_tol {
                 break 'outer BfgsStatus::Converged;
             }
-            for i in 0..n {
-                d[i] = -(0..n).map(|j| h[i * n + j] * g[j]).sum::<f64>();
-            }
+            neg_matvec(h, &g, &mut d);
             let mut d0: f64 = d.iter().zip(&g).map(|(a, b)| a * b).sum();
             if d0 >= 0.0 {
                 // Not a descent direction: reset to steepest descent.
@@ -180,17 +178,7 @@ pub fn bfgs(
                     }
                     first = false;
                 }
-                for i in 0..n {
-                    hy[i] = (0..n).map(|j| h[i * n + j] * y[j]).sum();
-                }
-                let yhy: f64 = y.iter().zip(&hy).map(|(a, b)| a * b).sum();
-                let rho = 1.0 / sy;
-                let c = (1.0 + rho * yhy) * rho;
-                for i in 0..n {
-                    for j in 0..n {
-                        h[i * n + j] += c * s[i] * s[j] - rho * (hy[i] * s[j] + s[i] * hy[j]);
-                    }
-                }
+                inverse_update(h, &s, &y, sy, &mut hy);
             }
             if opts.f_rel_tol > 0.0 && (f_old - f).abs() <= opts.f_rel_tol * f.abs().max(1.0) {
                 break 'outer BfgsStatus::Stalled;
@@ -204,6 +192,41 @@ pub fn bfgs(
         iterations,
         evaluations: evals,
         status,
+    }
+}
+
+crate::wide::dispatch! {
+    fn neg_matvec(h: &[f64], g: &[f64], d: &mut [f64]) => neg_matvec_body
+}
+
+/// `d = −H g` for the row-major `n×n` matrix `h`.
+#[inline(always)]
+fn neg_matvec_body(h: &[f64], g: &[f64], d: &mut [f64]) {
+    let n = g.len();
+    for i in 0..n {
+        d[i] = -(0..n).map(|j| h[i * n + j] * g[j]).sum::<f64>();
+    }
+}
+
+crate::wide::dispatch! {
+    fn inverse_update(h: &mut [f64], s: &[f64], y: &[f64], sy: f64, hy: &mut [f64]) => inverse_update_body
+}
+
+/// The BFGS update of the inverse-Hessian approximation `h` for the step `s` and gradient change
+/// `y` (`sy = sᵀy > 0`); `hy` is scratch.
+#[inline(always)]
+fn inverse_update_body(h: &mut [f64], s: &[f64], y: &[f64], sy: f64, hy: &mut [f64]) {
+    let n = s.len();
+    for i in 0..n {
+        hy[i] = (0..n).map(|j| h[i * n + j] * y[j]).sum();
+    }
+    let yhy: f64 = y.iter().zip(hy.iter()).map(|(a, b)| a * b).sum();
+    let rho = 1.0 / sy;
+    let c = (1.0 + rho * yhy) * rho;
+    for i in 0..n {
+        for j in 0..n {
+            h[i * n + j] += c * s[i] * s[j] - rho * (hy[i] * s[j] + s[i] * hy[j]);
+        }
     }
 }
 
