@@ -546,12 +546,16 @@ fn plan_summary(r: &PlanReport) -> String {
     if p.starts.len() > 1 {
         let _ = writeln!(
             o,
-            "  starts: {}, chosen {}; sampled U_max {}",
+            "  starts: {}, chosen {}; verified U_max (sampled) {}",
             p.starts.len(),
             p.chosen_start,
             p.starts
                 .iter()
-                .map(|s| format!("{:.4} ({:?})", s.sampled_u_max, s.status))
+                .map(|s| {
+                    let clear = if s.collision_free { "" } else { ", collides" };
+                    let (u, us, st) = (s.u_max, s.sampled_u_max, s.status);
+                    format!("{u:.4} ({us:.4}, {st:?}{clear})")
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         );

@@ -433,6 +433,17 @@ fn plan_prints_documented_json_and_exit_codes() {
         "coincide",
     ];
     assert_has_keys(&v["replay"], "replay.", &keys);
+    let keys = [
+        "start",
+        "status",
+        "sampled_u_max",
+        "u_max",
+        "collision_free",
+        "violation",
+        "evaluations",
+        "tracking_rounds",
+    ];
+    assert_has_keys(&v["starts"][0], "starts[0].", &keys);
     assert!(v["timing_s"]["plan"].as_f64().unwrap() > 0.0);
     assert!(v["timing_s"]["replay"].as_f64().unwrap() > 0.0);
     assert_eq!(v["status"], "planned");

@@ -8,6 +8,7 @@ pub mod endpoints;
 pub mod minimax;
 pub mod observer;
 mod optimise;
+mod refine;
 pub mod replay;
 pub mod result;
 pub mod spec;
@@ -29,13 +30,14 @@ use crate::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
-use observer::{PathKind, PlanObserver, Progress, ShapeRecord};
+use observer::{PathKind, PlanObserver, ShapeRecord};
 use replay::{ReplayOptions, replay};
 use spec::{End, PlanOptions};
 use std::sync::Arc;
-use verify::{Verification, fine_model, verify_with};
+use verify::{fine_model, verify_with};
 
-use optimise::{StartRun, noise};
+use optimise::noise;
+use refine::Verified;
 pub use result::{PlanResult, PlanStatus, StartSummary, Timing};
 
 /// A planning problem ready to run: the held end's conditions, the obstacles, and the two
@@ -325,96 +327,37 @@ impl Planner {
             .collect();
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
-        let runs = self.optimise_starts(&starts, &uniform, observer);
-        let feasible = |r: &StartRun| r.violation <= 1e-6;
+        let tol = 1e-6 * model.rod.length;
+        let runs = self.optimise_starts(&starts, &uniform, &check, observer);
+        // The plan is the start whose verified path is best: collision-free first, then feasible
+        // on the samples, then the lower true U_max (then the lower sampled maximum).
+        let rank = |r: &Verified| {
+            (
+                r.verification.collision_free(tol),
+                r.run.violation <= 1e-6,
+                -r.verification.u_max,
+                -r.run.sampled_max,
+            )
+        };
         let best = runs
             .iter()
             .enumerate()
-            .min_by(|(_, a), (_, b)| {
-                feasible(b)
-                    .cmp(&feasible(a))
-                    .then(a.sampled_max.total_cmp(&b.sampled_max))
+            .max_by(|(i, a), (j, b)| {
+                let (ka, kb) = (rank(a), rank(b));
+                (ka.0, ka.1)
+                    .cmp(&(kb.0, kb.1))
+                    .then(ka.2.total_cmp(&kb.2))
+                    .then(ka.3.total_cmp(&kb.3))
+                    .then(j.cmp(i))
             })
             .map(|(i, _)| i)
             .expect("at least one start");
-        let mut chosen = runs[best].clone();
         observer.phase("verify");
-        let mut ver = check(&chosen.z);
-        // Tunnelling between samples, or an energy peak between them: add the verification
-        // grid's worst k (and its neighbours on that grid) to the optimiser's samples and
-        // optimise again from the current path. The best verified path is kept (collision-free
-        // first, then the lower true U_max).
-        let tol = 1e-6 * model.rod.length;
-        let mut ks = uniform.clone();
-        let mut added = Vec::new();
-        let h = 1.0 / (self.options.verify_k - 1) as f64;
-        let gap = self.options.energy_gap;
-        let missed_peak = |r: &StartRun, v: &Verification| {
-            v.u_max - r.sampled_max > gap * r.sampled_max.abs().max(v.u_max.abs())
-        };
-        let better = |a: &Verification, b: &Verification| {
-            (a.collision_free(tol), -a.u_max) > (b.collision_free(tol), -b.u_max)
-        };
-        let mut kept: Option<(StartRun, Verification)> = None;
-        for _ in 0..self.options.sample_refinements {
-            let tunnels = !ver.collision_free(tol);
-            let peak = missed_peak(&chosen, &ver);
-            if !tunnels && !peak {
-                break;
-            }
-            let worst_k: Vec<f64> = ver
-                .obstacles
-                .iter()
-                .filter(|o| o.clearance < -tol)
-                .map(|o| o.k)
-                .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k))
-                .chain(peak.then_some(ver.k_at_u_max))
-                .collect();
-            for kw in worst_k {
-                // The grid's worst k and its grid neighbours, and the midpoints of the
-                // optimiser's interval holding it and of the intervals on either side: the
-                // sample spacing halves where the path tunnels or peaks.
-                let mut cand = vec![kw - h, kw, kw + h];
-                let i = ks
-                    .iter()
-                    .rposition(|&q| q <= kw)
-                    .unwrap_or(0)
-                    .min(ks.len() - 2);
-                for j in i.saturating_sub(1)..(i + 2).min(ks.len() - 1) {
-                    cand.push(0.5 * (ks[j] + ks[j + 1]));
-                }
-                for k in cand {
-                    if k > 0.0 && k < 1.0 && !ks.iter().any(|&q| (q - k).abs() < 0.25 * h) {
-                        ks.push(k);
-                        added.push(k);
-                    }
-                }
-            }
-            ks.sort_by(f64::total_cmp);
-            if kept.as_ref().is_none_or(|(_, kv)| better(&ver, kv)) {
-                kept = Some((chosen.clone(), ver.clone()));
-            }
-            observer.phase("optimise");
-            // Warm: only the sharpest stage again.
-            let last = self.options.sharpness.len() - 1;
-            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
-            let r = self.optimise_from(best, chosen.z.clone(), &ks, last, &mut sink);
-            chosen = StartRun {
-                evaluations: chosen.evaluations + r.evaluations,
-                ..r
-            };
-            observer.phase("verify");
-            ver = check(&chosen.z);
-        }
-        if let Some((kr, kv)) = kept
-            && better(&kv, &ver)
-        {
-            chosen = StartRun {
-                evaluations: chosen.evaluations,
-                ..kr
-            };
-            ver = kv;
-        }
+        let Verified {
+            run: chosen,
+            verification: ver,
+            added,
+        } = runs[best].clone();
         let chosen = &chosen;
         let t_plan = t0.elapsed().as_secs_f64();
 
@@ -454,13 +397,15 @@ impl Planner {
             starts: runs
                 .iter()
                 .enumerate()
-                .map(|(i, r)| StartSummary {
+                .map(|(i, v)| StartSummary {
                     start: i,
-                    status: r.status,
-                    sampled_u_max: r.sampled_max,
-                    violation: r.violation,
-                    evaluations: r.evaluations,
-                    tracking_rounds: r.tracking_rounds,
+                    status: v.run.status,
+                    sampled_u_max: v.run.sampled_max,
+                    u_max: v.verification.u_max,
+                    collision_free: v.verification.collision_free(tol),
+                    violation: v.run.violation,
+                    evaluations: v.run.evaluations,
+                    tracking_rounds: v.run.tracking_rounds,
                 })
                 .collect(),
             chosen_start: best,

@@ -2,6 +2,8 @@
 //! and several starts on parallel threads.
 
 use super::observer::{PlanObserver, Progress};
+use super::refine::Verified;
+use super::verify::Verification;
 use super::{Planner, spec};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
 
@@ -157,23 +159,26 @@ impl Planner {
     }
 
     /// Optimises from each of `starts` (perturbations of the straight-line path) on the samples
-    /// `ks`, on parallel threads when there are several, telling `observer` their progress as
-    /// it happens.
+    /// `uniform`, then verifies and refines each plan with `check` ([`Planner::refine`]), on
+    /// parallel threads when there are several starts, telling `observer` their progress as it
+    /// happens.
     pub(super) fn optimise_starts(
         &self,
         starts: &[Vec<f64>],
         uniform: &[f64],
+        check: &(dyn Fn(&[f64]) -> Verification + Sync),
         observer: &mut dyn PlanObserver,
-    ) -> Vec<StartRun> {
+    ) -> Vec<Verified> {
         let model = &self.base.model;
         if starts.len() == 1 {
             let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
-            vec![self.optimise_from(0, starts[0].clone(), uniform, 0, &mut sink)]
+            let run = self.optimise_from(0, starts[0].clone(), uniform, 0, &mut sink);
+            vec![self.refine(0, run, uniform, check, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
                 .min(starts.len());
-            let mut results: Vec<Option<StartRun>> = (0..starts.len()).map(|_| None).collect();
+            let mut results: Vec<Option<Verified>> = (0..starts.len()).map(|_| None).collect();
             // The starts report their progress through a channel, which this thread passes on
             // to the observer while they run.
             let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
@@ -195,7 +200,8 @@ impl Planner {
                             idx.into_iter()
                                 .map(|i| {
                                     let z0 = starts[i].clone();
-                                    (i, self.optimise_from(i, z0, uniform, 0, &mut sink))
+                                    let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
+                                    (i, self.refine(i, run, uniform, check, &mut sink))
                                 })
                                 .collect::<Vec<_>>()
                         })

@@ -27,6 +27,10 @@ pub struct StartSummary {
     pub status: AlStatus,
     /// Largest sampled energy (case units).
     pub sampled_u_max: f64,
+    /// `U_max` of the start's plan on the verification grid (case units).
+    pub u_max: f64,
+    /// Whether the start's plan keeps clear of every obstacle on the verification grid.
+    pub collision_free: bool,
     /// Constraint violation (dimensionless).
     pub violation: f64,
     /// Objective evaluations.

@@ -46,7 +46,8 @@ pub struct PlanSpec {
     /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
     #[serde(default = "d_sharp")]
     pub sharpness: Vec<f64>,
-    /// Independent optimiser starts (run in parallel; the best collision-free one wins).
+    /// Independent optimiser starts (run in parallel, each verified and refined on its own; the
+    /// collision-free one with the lowest verified `U_max` wins).
     #[serde(default = "d_starts")]
     pub starts: usize,
     /// Seed of the starts' pseudo-random perturbations.
