@@ -116,35 +116,40 @@ impl Model {
         for (hv, kv) in h.iter_mut().zip(&self.constant_hessian) {
             *hv += scale * kv;
         }
-        self.assemble_local(h, |q, hq| {
-            let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
-            let (dph, dps, _eps) = (shape.dph[q], shape.dps[q], shape.eps[q]);
-            let one = 1.0 + shape.eps[q];
-            let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
-            let omega = dph * ct + dps;
-            // Gravity: wg (1+ε) sθ cφ.
-            hq[TH][TH] = -wg * one * st * cp;
-            hq[TH][PH] = -wg * one * ct * sp;
-            hq[PH][PH] = -wg * one * st * cp;
-            hq[TH][EPS] = wg * ct * cp;
-            hq[PH][EPS] = -wg * st * sp;
-            // Flexure: ½ wf (θ'² + φ'² sθ²); its θ'θ' part, torsion's ψ'ψ' and extension's εε
-            // are constant (in `constant_hessian`).
-            if spatial {
-                let c2 = ct * ct - st * st;
-                hq[TH][TH] +=
-                    wf * dph * dph * c2 + wt * dph * dph * st * st - wt * omega * dph * ct;
-                hq[TH][DPH] = 2.0 * wf * dph * st * ct - wt * dph * st * ct - wt * omega * st;
-                hq[TH][DPS] = -wt * dph * st;
-                hq[DPH][DPH] = wf * st * st + wt * ct * ct;
-                hq[DPH][DPS] = wt * ct;
-            }
-            for r in hq.iter_mut() {
-                for v in r.iter_mut() {
-                    *v *= scale;
+        // A weightless planar rod (the energy is the quadratic form): every local entry below
+        // is zero, and the assembly would skip them all.
+        let quadratic = !self.energy_roots.is_empty();
+        if !quadratic {
+            self.assemble_local(h, |q, hq| {
+                let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+                let (dph, dps, _eps) = (shape.dph[q], shape.dps[q], shape.eps[q]);
+                let one = 1.0 + shape.eps[q];
+                let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
+                let omega = dph * ct + dps;
+                // Gravity: wg (1+ε) sθ cφ.
+                hq[TH][TH] = -wg * one * st * cp;
+                hq[TH][PH] = -wg * one * ct * sp;
+                hq[PH][PH] = -wg * one * st * cp;
+                hq[TH][EPS] = wg * ct * cp;
+                hq[PH][EPS] = -wg * st * sp;
+                // Flexure: ½ wf (θ'² + φ'² sθ²); its θ'θ' part, torsion's ψ'ψ' and extension's εε
+                // are constant (in `constant_hessian`).
+                if spatial {
+                    let c2 = ct * ct - st * st;
+                    hq[TH][TH] +=
+                        wf * dph * dph * c2 + wt * dph * dph * st * st - wt * omega * dph * ct;
+                    hq[TH][DPH] = 2.0 * wf * dph * st * ct - wt * dph * st * ct - wt * omega * st;
+                    hq[TH][DPS] = -wt * dph * st;
+                    hq[DPH][DPH] = wf * st * st + wt * ct * ct;
+                    hq[DPH][DPS] = wt * ct;
                 }
-            }
-        });
+                for r in hq.iter_mut() {
+                    for v in r.iter_mut() {
+                        *v *= scale;
+                    }
+                }
+            });
+        }
         if objective == Objective::Internal && !self.loads.is_empty() {
             let mut v = vec![[0.0; 3]; self.mesh.boundaries.len()];
             for (ld, &b) in self.loads.iter().zip(&self.load_boundary) {
@@ -178,6 +183,32 @@ impl Model {
             return;
         }
         let ps = &self.mesh.panel_start;
+        if self.layout.offset(Field::Phi).is_none() && self.layout.offset(Field::Eps).is_none() {
+            // Planar and inextensible: only the θθ entry, `−w (S₀ sθ + S₂ cθ) e eᵀ`, the same
+            // sums the general assembly does for it, without the absent quantities.
+            let (n, nb) = (self.n(), self.nb());
+            for (j, s) in suffix.iter().enumerate() {
+                if *s == [0.0; 3] {
+                    continue;
+                }
+                for q in ps[j]..ps[j + 1] {
+                    let (st, ct) = (shape.sth[q], shape.cth[q]);
+                    let f = s[0] * st * shape.cph[q] + s[1] * st * shape.sph[q] + s[2] * ct;
+                    let w = -self.mesh.weights[q] * (1.0 + shape.eps[q]) * f;
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let e = self.e_at(q);
+                    for i in 0..nb {
+                        let wi = w * e[i];
+                        for (r, v) in h[i * n..i * n + nb].iter_mut().zip(e) {
+                            *r += wi * v;
+                        }
+                    }
+                }
+            }
+            return;
+        }
         let mut panel_of = vec![0; self.nodes()];
         for j in 0..panels {
             for p in &mut panel_of[ps[j]..ps[j + 1]] {
