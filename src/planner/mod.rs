@@ -330,27 +330,17 @@ impl Planner {
         let tol = 1e-6 * model.rod.length;
         let runs = self.optimise_starts(&starts, &uniform, &check, observer);
         // The plan is the start whose verified path is best: collision-free first, then feasible
-        // on the samples, then the lower true U_max (then the lower sampled maximum).
-        let rank = |r: &Verified| {
-            (
-                r.verification.collision_free(tol),
-                r.run.violation <= 1e-6,
-                -r.verification.u_max,
-                -r.run.sampled_max,
-            )
-        };
-        let best = runs
-            .iter()
-            .enumerate()
-            .max_by(|(i, a), (j, b)| {
-                let (ka, kb) = (rank(a), rank(b));
-                (ka.0, ka.1)
-                    .cmp(&(kb.0, kb.1))
-                    .then(ka.2.total_cmp(&kb.2))
-                    .then(ka.3.total_cmp(&kb.3))
-                    .then(j.cmp(i))
+        // on the samples, then the lower true U_max, the lower sampled maximum, the lower index.
+        let class = |r: &Verified| (r.verification.collision_free(tol), r.run.violation <= 1e-6);
+        let best = (0..runs.len())
+            .max_by(|&i, &j| {
+                let (a, b) = (&runs[i], &runs[j]);
+                class(a)
+                    .cmp(&class(b))
+                    .then(b.verification.u_max.total_cmp(&a.verification.u_max))
+                    .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
+                    .then(j.cmp(&i))
             })
-            .map(|(i, _)| i)
             .expect("at least one start");
         observer.phase("verify");
         let Verified {
