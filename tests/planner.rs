@@ -216,6 +216,15 @@ fn energy_peaks_between_samples_are_refined() {
     assert!(on.added_samples.len() > off.added_samples.len());
 }
 
+/// A clamped strip swung from bent up to bent down, with no obstacle.
+fn free_swing_text() -> String {
+    plan_text(
+        r#"{ "x": 0.3, "z": 0.9, "theta": 0.6 }"#,
+        r#"{ "x": -0.25, "z": 0.85, "theta": -0.8 }"#,
+        "",
+    )
+}
+
 fn plan_text(start: &str, goal: &str, obstacles: &str) -> String {
     format!(
         r#"{{
@@ -232,11 +241,7 @@ fn plan_text(start: &str, goal: &str, obstacles: &str) -> String {
 /// end pose coincides with the plan within 1e-3 L everywhere.
 #[test]
 fn free_swing_coincides() {
-    let text = plan_text(
-        r#"{ "x": 0.3, "z": 0.9, "theta": 0.6 }"#,
-        r#"{ "x": -0.25, "z": 0.85, "theta": -0.8 }"#,
-        "",
-    );
+    let text = free_swing_text();
     let c = case::parse(&text, Path::new("free_swing.json")).unwrap();
     let p = Planner::from_case(&c).unwrap();
     let r = p.run(&mut Silent);
@@ -511,12 +516,7 @@ fn bad_planning_inputs_name_the_field() {
 /// plan is the collision-free one with the lowest verified U_max, and the run is reproducible.
 #[test]
 fn multi_start_reports_every_start_keeps_the_best_and_reproduces() {
-    let text = plan_text(
-        r#"{ "x": 0.3, "z": 0.9, "theta": 0.6 }"#,
-        r#"{ "x": -0.25, "z": 0.85, "theta": -0.8 }"#,
-        "",
-    )
-    .replace(
+    let text = free_swing_text().replace(
         r#""k_samples": 21"#,
         r#""k_samples": 21, "starts": 3, "seed": 7"#,
     );
@@ -588,12 +588,7 @@ impl dlo_planner::planner::observer::PlanObserver for Timeline {
 /// outer iterations), and every start reports.
 #[test]
 fn multi_start_progress_arrives_while_the_starts_run() {
-    let text = plan_text(
-        r#"{ "x": 0.3, "z": 0.9, "theta": 0.6 }"#,
-        r#"{ "x": -0.25, "z": 0.85, "theta": -0.8 }"#,
-        "",
-    )
-    .replace(r#""k_samples": 21"#, r#""k_samples": 21, "starts": 3"#);
+    let text = free_swing_text().replace(r#""k_samples": 21"#, r#""k_samples": 21, "starts": 3"#);
     let c = case::parse(&text, Path::new("live.json")).unwrap();
     let p = Planner::from_case(&c).unwrap();
     let mut t = Timeline::default();
