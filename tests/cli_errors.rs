@@ -402,6 +402,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     let logs = dir.join("logs");
     let logs_s = logs.to_str().unwrap();
     let json = |out: &str| -> serde_json::Value { serde_json::from_str(out).unwrap() };
+    let plan_json = |case: &str| run(&["plan", case, "--json", "--log-dir", logs_s]);
     let log_ok = |name: &str| {
         let bytes = std::fs::read(logs.join(format!("{name}.mcap"))).unwrap();
         assert!(bytes.starts_with(b"\x89MCAP0\r\n") && bytes.ends_with(b"\x89MCAP0\r\n"));
@@ -411,7 +412,7 @@ fn plan_prints_documented_json_and_exit_codes() {
         env!("CARGO_MANIFEST_DIR"),
         "/planning_cases/plan_cable_around_pillar.json"
     );
-    let (code, out, err) = run(&["plan", pillar, "--json", "--log-dir", logs_s]);
+    let (code, out, err) = plan_json(pillar);
     assert_eq!(code, 0, "{err}");
     let v = json(&out);
     let keys = [
@@ -481,13 +482,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     }
     let tunnels = dir.join("tunnels.json");
     std::fs::write(&tunnels, c.to_string()).unwrap();
-    let (code, out, err) = run(&[
-        "plan",
-        tunnels.to_str().unwrap(),
-        "--json",
-        "--log-dir",
-        logs_s,
-    ]);
+    let (code, out, err) = plan_json(tunnels.to_str().unwrap());
     assert_eq!(code, 4, "{err}");
     let v = json(&out);
     assert_eq!(v["status"], "collision");
@@ -508,13 +503,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     "k_samples": 21 } }"#,
     )
     .unwrap();
-    let (code, out, err) = run(&[
-        "plan",
-        snap.to_str().unwrap(),
-        "--json",
-        "--log-dir",
-        logs_s,
-    ]);
+    let (code, out, err) = plan_json(snap.to_str().unwrap());
     assert_eq!(code, 5, "{err}");
     let v = json(&out);
     assert_eq!(v["status"], "planned");
