@@ -107,7 +107,7 @@ impl Obstacle {
     fn project_local(&self, pl: Vector) -> Option<parry3d_f64::query::PointProjection> {
         Some(match &self.shape {
             ObstacleShape::HalfSpace(_) => return None,
-            ObstacleShape::Cuboid(s) => s.project_local_point(pl, false),
+            ObstacleShape::Cuboid(s) => project_cuboid(s.half_extents, pl),
             ObstacleShape::Ball(s) => s.project_local_point(pl, false),
             ObstacleShape::Capsule(s) => s.project_local_point(pl, false),
             ObstacleShape::Cylinder(s) => s.project_local_point(pl, false),
@@ -182,6 +182,33 @@ impl Obstacle {
     }
 }
 
+/// parry's projection of the local point `pt` onto the surface of the box with half extents
+/// `h` (`Aabb::do_project_local_point` of `Cuboid::project_local_point`, not solid), operation
+/// for operation so that the result is the same to the bit, but inlined: parry's is a call
+/// into another crate that the obstacle rows made for every point.
+#[inline(always)]
+fn project_cuboid(h: Vector, pt: Vector) -> parry3d_f64::query::PointProjection {
+    let mins_pt = -h - pt;
+    let pt_maxs = pt - h;
+    let shift = mins_pt.max(Vector::ZERO) - pt_maxs.max(Vector::ZERO);
+    if shift != Vector::ZERO {
+        return parry3d_f64::query::PointProjection::new(false, pt + shift);
+    }
+    // Inside: push the point out through the nearest face (ties: x, then y, then z; a zero
+    // coordinate counts as negative, as in parry). The box's centre is the origin, so the
+    // centred point is `pt` and `sign · pt` is `|pt|`.
+    let sgn = Vector::ONE.copysign(pt);
+    let diff = h - sgn * pt;
+    let shift = if diff.x <= diff.y && diff.x <= diff.z {
+        Vector::new(diff.x * sgn.x, 0.0, 0.0)
+    } else if diff.y <= diff.x && diff.y <= diff.z {
+        Vector::new(0.0, diff.y * sgn.y, 0.0)
+    } else {
+        Vector::new(0.0, 0.0, diff.z * sgn.z)
+    };
+    parry3d_f64::query::PointProjection::new(true, pt + shift)
+}
+
 /// Vertices and triangles of a mesh.
 pub type MeshData = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
@@ -231,4 +258,50 @@ pub fn read_obj(text: &str) -> Result<MeshData, String> {
         }
     }
     Ok((verts, faces))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The inlined box projection is parry's, to the bit: points inside, outside, on faces,
+    /// edges and corners, at the centre, with zero and negative-zero coordinates and with ties
+    /// between faces.
+    #[test]
+    fn cuboid_projection_is_parrys_to_the_bit() {
+        let mut s = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            2.0 * ((s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64)
+                - 1.0
+        };
+        let specials = [0.0, -0.0, 0.2, -0.2, 0.5, -0.5, 0.1, -0.1, 1e-300, 0.7];
+        for he in [[0.2, 0.5, 0.5], [0.3, 0.3, 0.3], [1e-3, 2.0, 0.7]] {
+            let cub = Cuboid::new(Vector::new(he[0], he[1], he[2]));
+            let mut points: Vec<Vector> = (0..20_000)
+                .map(|_| Vector::new(next(), next(), next()) * 0.8)
+                .collect();
+            for &a in &specials {
+                for &b in &specials {
+                    for &c in &specials {
+                        points.push(Vector::new(a, b, c));
+                    }
+                }
+            }
+            for pt in points {
+                let ours = project_cuboid(cub.half_extents, pt);
+                let theirs = cub.project_local_point(pt, false);
+                assert_eq!(ours.is_inside, theirs.is_inside, "{pt:?}");
+                for k in 0..3 {
+                    assert_eq!(
+                        ours.point[k].to_bits(),
+                        theirs.point[k].to_bits(),
+                        "{he:?} {pt:?}"
+                    );
+                }
+            }
+        }
+    }
 }
