@@ -3,7 +3,7 @@
 //! vector–Jacobian products `Σ_b v_b · ∂x(b)/∂a` computed in one backward pass.
 
 use crate::layout::Field;
-use crate::model::Model;
+use crate::model::{LANES, Model};
 
 /// A shape evaluated at the quadrature nodes, with positions at the mesh boundaries.
 #[derive(Clone, Debug, Default)]
@@ -78,6 +78,9 @@ impl Model {
                 grad[o + k] += total[c];
             }
         }
+        if !self.e_lanes.is_empty() {
+            return self.positions_vjp_lanes(shape, v, grad);
+        }
         for j in (0..self.mesh.panels()).rev() {
             let vb = v[j + 1];
             suffix = [suffix[0] + vb[0], suffix[1] + vb[1], suffix[2] + vb[2]];
@@ -107,6 +110,62 @@ impl Model {
                         grad[oe + i] += gep * e[i];
                     }
                 }
+            }
+        }
+    }
+
+    /// The angle and strain part of [`Model::positions_vjp_body`] for `nb ≤ LANES`: the same
+    /// operations in the same order, with each field's sums in a fixed-size array (registers)
+    /// instead of `grad`, so that a node's additions need not wait for the previous node's
+    /// stores.
+    #[inline(always)]
+    fn positions_vjp_lanes(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
+        let nb = self.nb();
+        let ot = 0;
+        let op = self.layout.offset(Field::Phi);
+        let oe = self.layout.offset(Field::Eps);
+        let ps = &self.mesh.panel_start;
+        let load = |o: Option<usize>, grad: &[f64]| {
+            let mut acc = [0.0; LANES];
+            if let Some(o) = o {
+                acc[..nb].copy_from_slice(&grad[o..o + nb]);
+            }
+            acc
+        };
+        let (mut at, mut ap, mut ae) = (load(Some(ot), grad), load(op, grad), load(oe, grad));
+        let mut suffix = [0.0; 3];
+        for j in (0..self.mesh.panels()).rev() {
+            let vb = v[j + 1];
+            suffix = [suffix[0] + vb[0], suffix[1] + vb[1], suffix[2] + vb[2]];
+            if suffix == [0.0; 3] {
+                continue;
+            }
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q];
+                let one = 1.0 + shape.eps[q];
+                let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+                let e = &self.e_lanes[q];
+                let gth = w * one * (suffix[0] * ct * cp + suffix[1] * ct * sp - suffix[2] * st);
+                for (a, &el) in at.iter_mut().zip(e) {
+                    *a += gth * el;
+                }
+                if op.is_some() {
+                    let gph = w * one * (-suffix[0] * st * sp + suffix[1] * st * cp);
+                    for (a, &el) in ap.iter_mut().zip(e) {
+                        *a += gph * el;
+                    }
+                }
+                if oe.is_some() {
+                    let gep = w * (suffix[0] * st * cp + suffix[1] * st * sp + suffix[2] * ct);
+                    for (a, &el) in ae.iter_mut().zip(e) {
+                        *a += gep * el;
+                    }
+                }
+            }
+        }
+        for (o, acc) in [(Some(ot), at), (op, ap), (oe, ae)] {
+            if let Some(o) = o {
+                grad[o..o + nb].copy_from_slice(&acc[..nb]);
             }
         }
     }

@@ -39,6 +39,10 @@ impl Default for Discretisation {
     }
 }
 
+/// Most Ritz functions per field for which the positions' vector–Jacobian product keeps its
+/// sums in registers (four AVX2 vectors).
+pub(crate) const LANES: usize = 16;
+
 /// The rod model, ready to evaluate shapes and energies.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -62,6 +66,9 @@ pub struct Model {
     pub(crate) e_rows: Vec<f64>,
     /// Basis derivatives, function-major.
     pub(crate) de_rows: Vec<f64>,
+    /// Basis values, node-major, each node's padded with zeros to [`LANES`] (empty when
+    /// `nb > LANES`): the positions' vector–Jacobian product keeps its sums in registers.
+    pub(crate) e_lanes: Vec<[f64; LANES]>,
     /// `w · Rf(t)/Rf`.
     pub(crate) wf: Vec<f64>,
     /// `w · Rt(t)/Rf`.
@@ -127,6 +134,17 @@ impl Model {
         let transpose =
             |m: &[f64]| -> Vec<f64> { (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect() };
         let (e_rows, de_rows) = (transpose(&e), transpose(&de));
+        let e_lanes = if nb <= LANES {
+            e.chunks_exact(nb)
+                .map(|row| {
+                    let mut p = [0.0; LANES];
+                    p[..nb].copy_from_slice(row);
+                    p
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
         let mut model = Model {
@@ -140,6 +158,7 @@ impl Model {
             de,
             e_rows,
             de_rows,
+            e_lanes,
             wf,
             wt,
             we,
