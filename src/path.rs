@@ -6,6 +6,8 @@
 //! of that null space and takes `cᵢ = N zᵢ`: the unknowns `z` satisfy the conditions exactly,
 //! with no multipliers and no drift.
 
+use crate::model::LANES;
+
 /// A deformation path between two shapes, parameterised by `z` (`m` blocks of `r` numbers).
 #[derive(Clone, Debug)]
 pub struct DeformationPath {
@@ -17,6 +19,9 @@ pub struct DeformationPath {
     pub terms: usize,
     /// Orthonormal basis of the admissible directions, `r` columns of length `n`.
     pub basis: Vec<Vec<f64>>,
+    /// The columns padded with zeros to [`LANES`] (empty when `n > LANES`), so that
+    /// [`DeformationPath::shape_at`] keeps its sums in registers.
+    lanes: Vec<[f64; LANES]>,
 }
 
 impl DeformationPath {
@@ -24,7 +29,7 @@ impl DeformationPath {
     /// (all directions when there are none).
     pub fn new(a0: Vec<f64>, a1: Vec<f64>, terms: usize, linear_rows: &[Vec<f64>]) -> Self {
         let n = a0.len();
-        let basis = if linear_rows.is_empty() {
+        let basis: Vec<Vec<f64>> = if linear_rows.is_empty() {
             (0..n)
                 .map(|j| (0..n).map(|i| f64::from(u8::from(i == j))).collect())
                 .collect()
@@ -35,11 +40,24 @@ impl DeformationPath {
                 .map(|q| ns.column(q).iter().copied().collect())
                 .collect()
         };
+        let lanes = if n <= LANES {
+            basis
+                .iter()
+                .map(|col| {
+                    let mut p = [0.0; LANES];
+                    p[..n].copy_from_slice(col);
+                    p
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         DeformationPath {
             a0,
             a1,
             terms,
             basis,
+            lanes,
         }
     }
 
@@ -85,6 +103,27 @@ impl DeformationPath {
     /// [`DeformationPath::shape_at`]'s loops (compiled twice, see [`crate::wide`]).
     #[inline(always)]
     fn shape_at_body(&self, z: &[f64], k: f64, out: &mut [f64]) {
+        if !self.lanes.is_empty() {
+            // The same operations in the same order, the sums in a fixed-size array.
+            let mut acc = [0.0; LANES];
+            for ((o, &x0), &x1) in acc.iter_mut().zip(&self.a0).zip(&self.a1) {
+                *o = (1.0 - k) * x0 + k * x1;
+            }
+            let r = self.lanes.len();
+            for i in 0..self.terms {
+                let w = Self::weight(i + 1, k);
+                for (q, col) in self.lanes.iter().enumerate() {
+                    let zq = w * z[i * r + q];
+                    if zq != 0.0 {
+                        for (o, bj) in acc.iter_mut().zip(col) {
+                            *o += zq * bj;
+                        }
+                    }
+                }
+            }
+            out.copy_from_slice(&acc[..out.len()]);
+            return;
+        }
         for ((o, &x0), &x1) in out.iter_mut().zip(&self.a0).zip(&self.a1) {
             *o = (1.0 - k) * x0 + k * x1;
         }
