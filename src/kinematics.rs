@@ -8,25 +8,49 @@ use crate::model::{LANES, Model};
 /// A shape evaluated at the quadrature nodes, with positions at the mesh boundaries.
 #[derive(Clone, Debug, Default)]
 pub struct Shape {
-    /// `θ` at nodes.
-    pub th: Vec<f64>,
-    /// `dθ/dt` at nodes (empty for a weightless planar rod: its energy is the constant
-    /// quadratic form of the model, and nothing else reads the curvature).
-    pub dth: Vec<f64>,
-    /// `φ` at nodes (zero for planar rods).
-    pub ph: Vec<f64>,
-    /// `dφ/dt` at nodes.
-    pub dph: Vec<f64>,
-    /// `dψ/dt` at nodes.
-    pub dps: Vec<f64>,
-    /// `ε` at nodes (zero for inextensible rods).
-    pub eps: Vec<f64>,
+    pub(crate) th: Vec<f64>,
+    pub(crate) dth: Vec<f64>,
+    pub(crate) ph: Vec<f64>,
+    pub(crate) dph: Vec<f64>,
+    pub(crate) dps: Vec<f64>,
+    pub(crate) eps: Vec<f64>,
     pub(crate) sth: Vec<f64>,
     pub(crate) cth: Vec<f64>,
     pub(crate) sph: Vec<f64>,
     pub(crate) cph: Vec<f64>,
+    /// Fields (bits in the order of the list in `evaluate_nodes_body`) that hold the constant
+    /// an absent field takes (0; 1 for `cos φ`) at every node: they need not be written again.
+    constant: u16,
     /// Dimensionless positions `x(b)/L` at the mesh boundaries.
     pub positions: Vec<[f64; 3]>,
+}
+
+impl Shape {
+    /// `θ` at the quadrature nodes.
+    pub fn th(&self) -> &[f64] {
+        &self.th
+    }
+    /// `dθ/dt` at the nodes (zero for a weightless planar rod: its energy is the constant
+    /// quadratic form of the model, and nothing else reads the curvature).
+    pub fn dth(&self) -> &[f64] {
+        &self.dth
+    }
+    /// `φ` at the nodes (zero for planar rods).
+    pub fn ph(&self) -> &[f64] {
+        &self.ph
+    }
+    /// `dφ/dt` at the nodes.
+    pub fn dph(&self) -> &[f64] {
+        &self.dph
+    }
+    /// `dψ/dt` at the nodes.
+    pub fn dps(&self) -> &[f64] {
+        &self.dps
+    }
+    /// `ε` at the nodes (zero for inextensible rods).
+    pub fn eps(&self) -> &[f64] {
+        &self.eps
+    }
 }
 
 impl Model {
@@ -140,11 +164,18 @@ impl Model {
             if suffix == [0.0; 3] {
                 continue;
             }
-            for q in ps[j]..ps[j + 1] {
-                let w = self.mesh.weights[q];
-                let one = 1.0 + shape.eps[q];
-                let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
-                let e = &self.e_lanes[q];
+            // The panel's nodes as slices: no bounds check per node.
+            let r = ps[j]..ps[j + 1];
+            let nodes = self.mesh.weights[r.clone()]
+                .iter()
+                .zip(&shape.eps[r.clone()])
+                .zip(&shape.sth[r.clone()])
+                .zip(&shape.cth[r.clone()])
+                .zip(&shape.sph[r.clone()])
+                .zip(&shape.cph[r.clone()])
+                .zip(&self.e_lanes[r]);
+            for ((((((&w, &eps), &st), &ct), &sp), &cp), e) in nodes {
+                let one = 1.0 + eps;
                 let gth = w * one * (suffix[0] * ct * cp + suffix[1] * ct * sp - suffix[2] * st);
                 for (a, &el) in at.iter_mut().zip(e) {
                     *a += gth * el;
@@ -241,24 +272,35 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
     let aps = lay.field(a, Field::Psi);
     let ae = lay.field(a, Field::Eps);
     let curvature = m.energy_roots.is_empty();
-    // Fields written below only need the right length; the others are zero.
-    for (v, present) in [
-        (&mut shape.th, true),
-        (&mut shape.dth, curvature),
-        (&mut shape.sth, true),
-        (&mut shape.cth, true),
-        (&mut shape.ph, ap.is_some()),
-        (&mut shape.dph, ap.is_some()),
-        (&mut shape.sph, ap.is_some()),
-        (&mut shape.cph, true),
-        (&mut shape.dps, aps.is_some()),
-        (&mut shape.eps, ae.is_some()),
-    ] {
-        if !present {
+    // Fields written below only need the right length; the others are zero (cos φ: one),
+    // written only when they do not hold that already.
+    let mut constant = shape.constant;
+    for (bit, (v, present, fill)) in [
+        (&mut shape.th, true, 0.0),
+        (&mut shape.dth, curvature, 0.0),
+        (&mut shape.sth, true, 0.0),
+        (&mut shape.cth, true, 0.0),
+        (&mut shape.ph, ap.is_some(), 0.0),
+        (&mut shape.dph, ap.is_some(), 0.0),
+        (&mut shape.sph, ap.is_some(), 0.0),
+        (&mut shape.cph, ap.is_some(), 1.0),
+        (&mut shape.dps, aps.is_some(), 0.0),
+        (&mut shape.eps, ae.is_some(), 0.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mask = 1u16 << bit;
+        if present {
+            v.resize(nn, 0.0);
+            constant &= !mask;
+        } else if constant & mask == 0 || v.len() != nn {
             v.clear();
+            v.resize(nn, fill);
+            constant |= mask;
         }
-        v.resize(nn, 0.0);
     }
+    shape.constant = constant;
     // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
     let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
         let mut rows = c.iter().zip(m.chunks_exact(nn));
@@ -283,8 +325,6 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
         rows(ap, &m.e_rows, &mut shape.ph);
         rows(ap, &m.de_rows, &mut shape.dph);
         crate::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
-    } else {
-        shape.cph.iter_mut().for_each(|v| *v = 1.0);
     }
     if let Some(aps) = aps {
         rows(aps, &m.de_rows, &mut shape.dps);
@@ -300,10 +340,14 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
     if ap.is_none() && ae.is_none() {
         // In the x–z plane, inextensible: the same sums without the zero terms.
         for j in 0..m.mesh.panels() {
-            for q in ps[j]..ps[j + 1] {
-                let w = m.mesh.weights[q];
-                x[0] += w * shape.sth[q];
-                x[2] += w * shape.cth[q];
+            let r = ps[j]..ps[j + 1];
+            let nodes = m.mesh.weights[r.clone()]
+                .iter()
+                .zip(&shape.sth[r.clone()])
+                .zip(&shape.cth[r]);
+            for ((&w, &st), &ct) in nodes {
+                x[0] += w * st;
+                x[2] += w * ct;
             }
             shape.positions.push(x);
         }

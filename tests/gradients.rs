@@ -194,7 +194,7 @@ fn weightless_planar_energy_is_its_quadratic_form() {
             let dth: f64 = th.iter().zip(&d).map(|(c, e)| c * e).sum();
             flex_q += 0.5 * w * r.flexural.at(t) / rf * dth * dth;
             if ext {
-                let e = shape.eps[q];
+                let e = shape.eps()[q];
                 ext_q += 0.5 * w * r.extensional.unwrap().at(t) * l * l / rf * e * e;
             }
         }
