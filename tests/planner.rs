@@ -594,7 +594,7 @@ fn multi_start_progress_arrives_while_the_starts_run() {
     let mut t = Timeline::default();
     p.run(&mut t);
     let at = |name: &str| t.phases.iter().find(|(n, _)| n == name).unwrap().1;
-    let (begin, end) = (at("optimise"), at("verify"));
+    let (begin, end) = (at("optimise"), at("select"));
     let first = t.progress.first().unwrap().1;
     let whole = (end - begin).as_secs_f64();
     let waited = (first - begin).as_secs_f64();

@@ -342,7 +342,7 @@ impl Planner {
                     .then(j.cmp(&i))
             })
             .expect("at least one start");
-        observer.phase("verify");
+        observer.phase("select");
         let Verified {
             run: chosen,
             verification: ver,

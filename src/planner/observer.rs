@@ -69,7 +69,8 @@ pub struct Progress {
 pub trait PlanObserver {
     /// Called once before anything else with the model every shape refers to.
     fn begin(&mut self, _model: &Model) {}
-    /// A phase starts (`"endpoints"`, `"optimise"`, `"verify"`, `"replay"`).
+    /// A phase starts: `"endpoints"`, `"optimise"` (every start optimises, verifies and refines
+    /// its plan), `"select"` (the start with the best verified plan is chosen), `"replay"`.
     fn phase(&mut self, _name: &str) {}
     /// A shape was computed.
     fn shape(&mut self, _model: &Model, _record: &ShapeRecord) {}
