@@ -14,6 +14,7 @@
 //!
 //! The library prints nothing.
 
+pub mod balance;
 pub mod basis;
 pub mod case;
 pub mod constraints;

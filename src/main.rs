@@ -250,13 +250,14 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
     }
     let t0 = Instant::now();
     let a = c.initial.clone();
-    let (energy, viol, reactions, kkt) = evaluate_shape(&mut c.problem, &a);
+    let (energy, viol, reactions, kkt, balance) = evaluate_shape(&mut c.problem, &a);
     let p = &c.problem;
     let report = ShapeReport {
         case: c.name.clone(),
         status: "evaluated".into(),
         energy: energy.into(),
         reactions,
+        balance,
         max_violation: viol,
         kkt_residual: Some(kkt),
         stable: None,
@@ -326,6 +327,12 @@ fn print_report(r: &ShapeReport, json: bool) {
             re.moment[2]
         );
     }
+    let b = &r.balance;
+    let _ = writeln!(
+        o,
+        "  moment balance residual [{:+.3e}, {:+.3e}, {:+.3e}] ({:.1e} of the largest moment)",
+        b.moment_residual[0], b.moment_residual[1], b.moment_residual[2], b.relative
+    );
     for p in &r.points {
         let _ = writeln!(
             o,

@@ -77,6 +77,8 @@ pub struct ShapeReport {
     pub energy: EnergyReport,
     /// Reactions at each constraint (force and moment on the rod, case units).
     pub reactions: Vec<Reaction>,
+    /// Global moment balance of the reactions, loads and gravity.
+    pub balance: crate::balance::Balance,
     /// Largest constraint violation (positions in units of `L`).
     pub max_violation: f64,
     /// KKT residual (units of `Rf/L`); `null` for an evaluation.
@@ -134,6 +136,7 @@ impl ShapeReport {
             status: status.unwrap_or_default(),
             energy: sol.energy.into(),
             reactions: sol.reactions.clone(),
+            balance: sol.balance,
             max_violation: sol.max_violation,
             kkt_residual: Some(sol.kkt_residual),
             stable: sol.stable,

@@ -73,6 +73,8 @@ pub struct StaticSolution {
     pub kkt_residual: f64,
     /// Reactions at each constraint.
     pub reactions: Vec<Reaction>,
+    /// The global moment balance of the reactions, loads and gravity.
+    pub balance: crate::balance::Balance,
     /// Stability verdict (`None` if not computed).
     pub stable: Option<bool>,
     /// Smallest eigenvalue of the reduced Hessian (dimensionless), if computed.
@@ -129,7 +131,9 @@ fn finish(
     crate::optim::Nlp::values(p, &a, &mut c);
     let energy_scaled = p.terms();
     let reactions = reactions(p, &a, &out.lambda);
+    let balance = crate::balance::balance(p, &a, &out.lambda, &reactions);
     StaticSolution {
+        balance,
         energy: energy_scaled.scaled(p.model.rod.energy_unit()),
         energy_scaled,
         status: out.status,
@@ -285,7 +289,16 @@ fn least_squares_moment(
 /// Evaluates the given coefficients without optimising: energy terms, constraint violation, and
 /// the least-squares multipliers `argmin ‖∇V + Jᵀλ‖` (the reactions the shape would need if it
 /// were an equilibrium; the returned KKT residual says how far it is from one).
-pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> (EnergyTerms, f64, Vec<Reaction>, f64) {
+pub fn evaluate_shape(
+    p: &mut StaticProblem,
+    a: &[f64],
+) -> (
+    EnergyTerms,
+    f64,
+    Vec<Reaction>,
+    f64,
+    crate::balance::Balance,
+) {
     use crate::optim::Nlp;
     use crate::optim::augmented_lagrangian::{kkt_residual, least_squares_multipliers, violation};
     let mut c = vec![0.0; p.m()];
@@ -295,10 +308,13 @@ pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> (EnergyTerms, f64, Ve
     let zero = vec![0.0; p.m()];
     let (lambda, kkt) = least_squares_multipliers(p, a, &c, &zero, 1e-7)
         .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
+    let reactions = reactions(p, a, &lambda);
+    let balance = crate::balance::balance(p, a, &lambda, &reactions);
     (
         terms.scaled(p.model.rod.energy_unit()),
         viol,
-        reactions(p, a, &lambda),
+        reactions,
         kkt,
+        balance,
     )
 }

@@ -138,8 +138,9 @@ fn end_shape(
     let mut p = pose.problem(base);
     let sol = if end.position.is_empty() && end.angles.is_empty() {
         let a = end.shape.clone().expect("validated: shape or pose");
-        let (energy, viol, reactions, kkt) = crate::statics::evaluate_shape(&mut p, &a);
+        let (energy, viol, reactions, kkt, balance) = crate::statics::evaluate_shape(&mut p, &a);
         StaticSolution {
+            balance,
             energy_scaled: energy.scaled(1.0 / base.model.rod.energy_unit()),
             energy,
             status: if viol <= 1e-6 {
