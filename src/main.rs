@@ -250,16 +250,17 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
     }
     let t0 = Instant::now();
     let a = c.initial.clone();
-    let (energy, viol, reactions, kkt, balance) = evaluate_shape(&mut c.problem, &a);
+    let ev = evaluate_shape(&mut c.problem, &a);
     let p = &c.problem;
     let report = ShapeReport {
         case: c.name.clone(),
         status: "evaluated".into(),
-        energy: energy.into(),
-        reactions,
-        balance,
-        max_violation: viol,
-        kkt_residual: Some(kkt),
+        energy: ev.energy.into(),
+        reactions: ev.reactions,
+        balance: ev.balance,
+        self_contacts: ev.self_contacts,
+        max_violation: ev.max_violation,
+        kkt_residual: Some(ev.kkt_residual),
         stable: None,
         min_reduced_eigenvalue: None,
         neutral_modes: None,
@@ -333,6 +334,16 @@ fn print_report(r: &ShapeReport, json: bool) {
         "  moment balance residual [{:+.3e}, {:+.3e}, {:+.3e}] ({:.1e} of the largest moment)",
         b.moment_residual[0], b.moment_residual[1], b.moment_residual[2], b.relative
     );
+    if let Some(c) = r.self_contacts.first() {
+        let f = (c.force[0].powi(2) + c.force[1].powi(2) + c.force[2].powi(2)).sqrt();
+        let _ = writeln!(
+            o,
+            "  self-contact at {} pair(s) of points; largest force {f:.6e} between s = {:.4} and s = {:.4}",
+            r.self_contacts.len(),
+            c.s[0],
+            c.s[1]
+        );
+    }
     for p in &r.points {
         let _ = writeln!(
             o,

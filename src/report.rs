@@ -79,6 +79,8 @@ pub struct ShapeReport {
     pub reactions: Vec<Reaction>,
     /// Global moment balance of the reactions, loads and gravity.
     pub balance: crate::balance::Balance,
+    /// Where the rod touches itself, largest force first (empty without self-contact).
+    pub self_contacts: Vec<crate::statics::SelfContactForce>,
     /// Largest constraint violation (positions in units of `L`).
     pub max_violation: f64,
     /// KKT residual (units of `Rf/L`); `null` for an evaluation.
@@ -137,6 +139,7 @@ impl ShapeReport {
             energy: sol.energy.into(),
             reactions: sol.reactions.clone(),
             balance: sol.balance,
+            self_contacts: sol.self_contacts.clone(),
             max_violation: sol.max_violation,
             kkt_residual: Some(sol.kkt_residual),
             stable: sol.stable,

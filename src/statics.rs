@@ -54,6 +54,37 @@ pub struct Reaction {
     pub angle_torques: [f64; 3],
 }
 
+/// A contact of the rod with itself: the force the strand at `s[0]` takes from the strand at
+/// `s[1]` (which takes the opposite), in case units.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SelfContactForce {
+    /// Arc lengths of the two closest points, `s[0] < s[1]`.
+    pub s: [f64; 2],
+    /// Force on the strand at `s[0]`.
+    pub force: [f64; 3],
+}
+
+/// The self-contact forces of multipliers `lambda`, largest first.
+pub fn self_contacts(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<SelfContactForce> {
+    let m = &p.model;
+    let (l, fu) = (m.rod.length, m.rod.force_unit());
+    let shape = m.evaluate(a);
+    let mut out = Vec::new();
+    for (k, con) in p.constraints.iter().enumerate() {
+        if let Some(sc) = downcast::<crate::constraints::SelfContactConstraint>(con.as_ref()) {
+            for (t, f) in sc.contacts(m, &shape, &lambda[p.rows_of(k)]) {
+                out.push(SelfContactForce {
+                    s: t.map(|v| v * l),
+                    force: f.map(|v| v * fu),
+                });
+            }
+        }
+    }
+    let size = |c: &SelfContactForce| c.force.iter().map(|v| v * v).sum::<f64>();
+    out.sort_by(|a, b| size(b).total_cmp(&size(a)));
+    out
+}
+
 /// A solved static shape.
 #[derive(Clone, Debug)]
 pub struct StaticSolution {
@@ -75,6 +106,8 @@ pub struct StaticSolution {
     pub reactions: Vec<Reaction>,
     /// The global moment balance of the reactions, loads and gravity.
     pub balance: crate::balance::Balance,
+    /// Where the rod touches itself and how hard (largest first; empty without self-contact).
+    pub self_contacts: Vec<SelfContactForce>,
     /// Stability verdict (`None` if not computed).
     pub stable: Option<bool>,
     /// Smallest eigenvalue of the reduced Hessian (dimensionless), if computed.
@@ -132,8 +165,10 @@ fn finish(
     let energy_scaled = p.terms();
     let reactions = reactions(p, &a, &out.lambda);
     let balance = crate::balance::balance(p, &a, &out.lambda, &reactions);
+    let self_contacts = self_contacts(p, &a, &out.lambda);
     StaticSolution {
         balance,
+        self_contacts,
         energy: energy_scaled.scaled(p.model.rod.energy_unit()),
         energy_scaled,
         status: out.status,
@@ -289,16 +324,7 @@ fn least_squares_moment(
 /// Evaluates the given coefficients without optimising: energy terms, constraint violation, and
 /// the least-squares multipliers `argmin ‖∇V + Jᵀλ‖` (the reactions the shape would need if it
 /// were an equilibrium; the returned KKT residual says how far it is from one).
-pub fn evaluate_shape(
-    p: &mut StaticProblem,
-    a: &[f64],
-) -> (
-    EnergyTerms,
-    f64,
-    Vec<Reaction>,
-    f64,
-    crate::balance::Balance,
-) {
+pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> Evaluation {
     use crate::optim::Nlp;
     use crate::optim::augmented_lagrangian::{kkt_residual, least_squares_multipliers, violation};
     let mut c = vec![0.0; p.m()];
@@ -309,12 +335,30 @@ pub fn evaluate_shape(
     let (lambda, kkt) = least_squares_multipliers(p, a, &c, &zero, 1e-7)
         .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
     let reactions = reactions(p, a, &lambda);
-    let balance = crate::balance::balance(p, a, &lambda, &reactions);
-    (
-        terms.scaled(p.model.rod.energy_unit()),
-        viol,
+    Evaluation {
+        energy: terms.scaled(p.model.rod.energy_unit()),
+        max_violation: viol,
+        balance: crate::balance::balance(p, a, &lambda, &reactions),
+        self_contacts: self_contacts(p, a, &lambda),
         reactions,
-        kkt,
-        balance,
-    )
+        kkt_residual: kkt,
+    }
+}
+
+/// What [`evaluate_shape`] finds, with the least-squares multipliers standing for the
+/// reactions the shape would need.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// Energy terms in the case's units.
+    pub energy: EnergyTerms,
+    /// Largest constraint violation (dimensionless).
+    pub max_violation: f64,
+    /// Reactions at each constraint.
+    pub reactions: Vec<Reaction>,
+    /// KKT residual (dimensionless).
+    pub kkt_residual: f64,
+    /// Global moment balance.
+    pub balance: crate::balance::Balance,
+    /// Self-contact forces, largest first.
+    pub self_contacts: Vec<SelfContactForce>,
 }

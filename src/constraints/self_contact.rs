@@ -81,6 +81,39 @@ pub fn segment_distance(p1: [f64; 3], q1: [f64; 3], p2: [f64; 3], q2: [f64; 3]) 
 }
 
 impl SelfContactConstraint {
+    /// The contact forces of the multipliers `lambda` (one per pair, dimensionless forces): for
+    /// every pair that pushes, the dimensionless arc lengths `(t_a, t_b)`, `t_a < t_b`, of its
+    /// closest points and the force on the strand at `t_a`, along the line from the closest
+    /// point at `t_b` to it (the strand at `t_b` takes the opposite force).
+    pub fn contacts(
+        &self,
+        m: &Model,
+        shape: &Shape,
+        lambda: &[f64],
+    ) -> Vec<([f64; 2], [f64; 3])> {
+        let t = |b: usize| m.mesh.boundaries[b];
+        let mut out = Vec::new();
+        for (&li, &(i, j)) in lambda.iter().zip(&self.pairs) {
+            if li <= 0.0 {
+                continue;
+            }
+            let (p1, q1) = self.chord(shape, i);
+            let (p2, q2) = self.chord(shape, j);
+            let (s, u, d) = segment_distance(p1, q1, p2, q2);
+            if d < 1e-300 {
+                continue;
+            }
+            let n: [f64; 3] =
+                std::array::from_fn(|k| (p1[k] + s * (q1[k] - p1[k]) - p2[k] - u * (q2[k] - p2[k])) / d);
+            let along = |c: usize, f: f64| {
+                let (a, b) = (t(self.samples[c]), t(self.samples[c + 1]));
+                a + f * (b - a)
+            };
+            out.push(([along(i, s), along(j, u)], n.map(|v| li * v)));
+        }
+        out
+    }
+
     fn chord(&self, shape: &Shape, i: usize) -> ([f64; 3], [f64; 3]) {
         (
             shape.positions[self.samples[i]],

@@ -138,11 +138,13 @@ fn end_shape(
     let mut p = pose.problem(base);
     let sol = if end.position.is_empty() && end.angles.is_empty() {
         let a = end.shape.clone().expect("validated: shape or pose");
-        let (energy, viol, reactions, kkt, balance) = crate::statics::evaluate_shape(&mut p, &a);
+        let ev = crate::statics::evaluate_shape(&mut p, &a);
+        let viol = ev.max_violation;
         StaticSolution {
-            balance,
-            energy_scaled: energy.scaled(1.0 / base.model.rod.energy_unit()),
-            energy,
+            balance: ev.balance,
+            self_contacts: ev.self_contacts,
+            energy_scaled: ev.energy.scaled(1.0 / base.model.rod.energy_unit()),
+            energy: ev.energy,
             status: if viol <= 1e-6 {
                 SolveStatus::Converged
             } else {
@@ -150,8 +152,8 @@ fn end_shape(
             },
             lambda: vec![0.0; crate::optim::Nlp::m(&p)],
             max_violation: viol,
-            kkt_residual: kkt,
-            reactions,
+            kkt_residual: ev.kkt_residual,
+            reactions: ev.reactions,
             stable: None,
             min_reduced_eigenvalue: None,
             neutral_modes: None,
