@@ -2,8 +2,9 @@
 //!
 //! Everything that acts on the rod from outside — supports (position, relative-position and
 //! orientation constraints, the fixed base), obstacle contacts, point loads and gravity — must
-//! have zero total moment. The base's force is defined to close the force balance
-//! ([`crate::statics::reactions`]), so the moment is what tests the reactions. Self-contact
+//! have zero total force and moment. A fixed base's force is defined to close the force balance
+//! ([`crate::statics::reactions`]), so there the moment is what tests the reactions; with a
+//! free base the force balance is a test too. Self-contact
 //! forces come in equal, opposite and collinear pairs and cancel; they are left out.
 //!
 //! The residual is zero, up to rounding, wherever every rigid rotation of the rod is a change of
@@ -22,14 +23,17 @@ use crate::problem::StaticProblem;
 use crate::statics::Reaction;
 use serde::Serialize;
 
-/// The total moment on the rod about its base point `x(0)`, in case units.
+/// The total force and moment on the rod (moments about its base point `x(0)`), in case units.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Balance {
+    /// `Σ F` over supports, contacts, loads and gravity: zero by construction with a fixed base
+    /// (its force closes the sum), a check with a free one.
+    pub force_residual: [f64; 3],
     /// `Σ (x − x(0)) × F + Σ M` over supports, contacts, loads and gravity.
     pub moment_residual: [f64; 3],
-    /// `|moment_residual|` over the largest moment in the sum (at least `10⁻⁶ · |F| · L` for the
-    /// largest force `F`, so that a rod loaded only along its supports' arms gives rounding,
-    /// not 1; 0 when nothing acts).
+    /// `max(|moment_residual|, |force_residual| · L)` over the largest moment in the sum, but at
+    /// least `10⁻³ · |F| · L` for the largest force `F` and `10⁻¹² · Rf/L`, so that a rod loaded
+    /// only along its supports' arms, or not at all, gives rounding, not 1.
     pub relative: f64,
 }
 
@@ -55,20 +59,27 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
     let at = |b: usize| shape.positions[b].map(|v| v * l);
     let x0 = at(0);
     let arm = |x: [f64; 3]| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
-    let mut sum = [0.0; 3];
+    let (mut sum, mut total) = ([0.0; 3], [0.0; 3]);
     let (mut largest, mut largest_force) = (0.0_f64, 0.0_f64);
-    // A moment, and the force it comes from (zero for a couple).
-    let mut add = |mo: [f64; 3], f: [f64; 3]| {
+    // A moment and the force it comes from (zero for a couple); `counted`: the force is in the
+    // force sum already.
+    let mut add = |mo: [f64; 3], f: [f64; 3], counted: bool| {
         for (s, v) in sum.iter_mut().zip(mo) {
             *s += v;
+        }
+        if !counted {
+            for (s, v) in total.iter_mut().zip(f) {
+                *s += v;
+            }
         }
         largest = largest.max(norm(mo));
         largest_force = largest_force.max(norm(f));
     };
-    // Orientation constraints carry their moment in the reaction; the base's force acts at
-    // x(0) and has no arm.
+    // The reactions' forces enter the force sum here (obstacles report their total); their
+    // moments below, from the points where they act. Orientation constraints carry their
+    // moment in the reaction; the base's force acts at x(0) and has no arm.
     for r in reactions {
-        add(r.moment, r.force);
+        add(r.moment, r.force, false);
     }
     for (k, con) in p.constraints.iter().enumerate() {
         let lam = &lambda[p.rows_of(k)];
@@ -83,23 +94,23 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
                 };
                 f[comp] += sign * li * fu;
             }
-            add(cross(arm(at(pc.boundary)), f), f);
+            add(cross(arm(at(pc.boundary)), f), f, true);
         } else if let Some(rc) = any.downcast_ref::<RelativePositionConstraint>() {
-            // `−λ` at the second point and `+λ` at the first.
+            // The reaction's force at the second point, its opposite at the first.
             let mut f = [0.0; 3];
             for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
                 f[comp] -= li * fu;
             }
             let back = f.map(|v| -v);
-            add(cross(arm(at(rc.to)), f), f);
-            add(cross(arm(at(rc.from)), back), back);
+            add(cross(arm(at(rc.to)), f), f, true);
+            add(cross(arm(at(rc.from)), back), back, false);
         } else if let Some(ob) = any.downcast_ref::<ObstacleConstraint>() {
             for (&li, &b) in lam.iter().zip(&ob.samples) {
                 if li > 0.0 {
                     let x = at(b);
                     let (_, n) = ob.obstacle.signed_distance(x);
                     let f = n.map(|v| li * v * fu);
-                    add(cross(arm(x), f), f);
+                    add(cross(arm(x), f), f, true);
                 }
             }
         }
@@ -109,7 +120,7 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
     for ld in &m.loads {
         let x = m.position_at(a, ld.t).map(|v| v * l);
         let f = ld.force.map(|v| v * fu);
-        add(cross(arm(x), f), f);
+        add(cross(arm(x), f), f, false);
     }
     // Gravity: −D(s) x̂ per unit length, over the quadrature nodes.
     if m.rod.weight.mean() != 0.0 {
@@ -121,11 +132,14 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
                 *gc += v;
             }
         }
-        add(g, [m.rod.weight.mean() * l, 0.0, 0.0]);
+        add(g, [-m.rod.weight.mean() * l, 0.0, 0.0], false);
     }
-    let residual = norm(sum);
-    let scale = largest.max(1e-6 * largest_force * l);
+    let residual = norm(sum).max(norm(total) * l);
+    let scale = largest
+        .max(1e-3 * largest_force * l)
+        .max(1e-12 * m.rod.energy_unit());
     Balance {
+        force_residual: total,
         moment_residual: sum,
         relative: if scale > 0.0 { residual / scale } else { 0.0 },
     }

@@ -14,14 +14,16 @@ fn solve(c: &mut case::Case) -> StaticSolution {
     sol
 }
 
-/// Planar shipped cases — clamped and pinned ends, extension, gravity, a loop — balance to
-/// rounding (relative 1e-9): the moments of the supports' forces about the base, the clamps'
-/// moments and, for the heavy strip, the moment of its weight.
+/// Planar shipped cases — clamped and pinned ends, extension, gravity, a loop, and grasp (a),
+/// whose base is free, so that its force balance is a test too — balance to rounding (relative
+/// 1e-9): the moments of the supports' forces about the base, the clamps' moments and, for the
+/// heavy strip, the moment of its weight.
 #[test]
 fn planar_shapes_balance_to_rounding() {
     for name in [
         "clamped_buckling_060",
         "pinned_buckling_080",
+        "grasp_a_080",
         "extension_rho_e_300",
         "gravity_rho_g_050",
         "topology_knot_free_020",
