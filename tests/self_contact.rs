@@ -2,6 +2,10 @@
 
 use dlo_planner::case;
 use dlo_planner::constraints::segment_distance;
+use dlo_planner::layout::Field;
+use dlo_planner::planner::observer::Silent;
+use dlo_planner::planner::verify::{fine_model, verify_with};
+use dlo_planner::planner::{PlanStatus, Planner};
 use dlo_planner::statics::{SolveStatus, StaticSolution, solve_static};
 use std::path::Path;
 
@@ -80,4 +84,62 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
     let size = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
     assert!(size > 1e-4, "contact force {f:?}");
     assert!(f[1].abs() > 0.99 * size, "contact force not across the plane: {f:?}");
+}
+
+/// Self-contact rows that decide a plan. Start: the crossed loop of
+/// [`a_loop_that_would_cross_itself_touches_itself_instead`] (held at s = L by the controlled
+/// end), its first leg passing over the second; goal: its mirror image in the x–z plane
+/// (φ, ψ → −φ, −ψ), the first leg passing under. The straight-line path takes the legs through
+/// each other (the gap d − 2r between chords is −2r halfway: they intersect), and so does the
+/// plan made without self-contact rows. With them, the plan keeps every pair of chords 2r apart
+/// on the verification grid, which it never saw, at the same U_max (the end shapes' energy), and
+/// the end pose alone reproduces it.
+#[test]
+fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
+    let (c, held) = crossed_loop(true);
+    let lay = &c.problem.model.layout;
+    let field = |f: Field, sign: f64| -> Vec<f64> {
+        lay.field(&held.a, f).unwrap().iter().map(|v| sign * v).collect()
+    };
+    let (phi, theta, psi) = (
+        field(Field::Phi, 1.0),
+        field(Field::Theta, 1.0),
+        field(Field::Psi, 1.0),
+    );
+    let (phi_m, psi_m) = (field(Field::Phi, -1.0), field(Field::Psi, -1.0));
+    let plan = |self_contact: bool| {
+        let text = format!(
+            r#"{{ "name": "flip", "planar": false, "self_contact": {self_contact},
+  "rod": {{ "length": 100.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0, "radius": 0.5 }},
+  "constraints": [
+    {{ "type": "orientation", "s": 0.0, "phi": 0.0, "theta": 1.5707963267948966, "psi": 0.0 }}
+  ],
+  "plan": {{
+    "start": {{ "shape": {{ "phi": {phi:?}, "theta": {theta:?}, "psi": {psi:?} }} }},
+    "goal": {{ "shape": {{ "phi": {phi_m:?}, "theta": {theta:?}, "psi": {psi_m:?} }} }},
+    "k_samples": 21 }} }}"#
+        );
+        let c = case::parse(&text, Path::new("flip.json")).unwrap();
+        let p = Planner::from_case(&c).unwrap();
+        let r = p.run(&mut Silent);
+        let fine = fine_model(&p.base.model, 256, 4);
+        let path = p.path();
+        let gap = |z: &[f64]| {
+            verify_with(&fine, &path, z, 201, &[], p.base.objective, true)
+                .self_contact
+                .unwrap()
+        };
+        let straight = gap(&vec![0.0; path.n_vars()]);
+        (r.status, r.u_max, r.replay.coincide, straight, gap(&r.z))
+    };
+    let (status0, u0, _, straight, (g0, k0)) = plan(false);
+    let (status1, u1, coincide1, _, (g1, k1)) = plan(true);
+    let r = c.problem.model.rod.radius;
+    assert!(straight.0 < -1.9 * r, "straight-line path: gap {straight:?}");
+    assert_eq!(status0, PlanStatus::Planned);
+    assert!(g0 < -r, "plan without the rows: gap {g0} at k = {k0}");
+    assert_eq!(status1, PlanStatus::Planned);
+    assert!(g1 >= 0.0, "plan with the rows: gap {g1} at k = {k1}");
+    assert!((u1 - u0).abs() <= 1e-6 * u0, "U_max {u1} with the rows, {u0} without");
+    assert!(coincide1, "the end pose does not reproduce the plan with the rows");
 }
