@@ -336,6 +336,7 @@ pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> Evaluation {
         .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
     let reactions = reactions(p, a, &lambda);
     Evaluation {
+        lambda: lambda.clone(),
         energy: terms.scaled(p.model.rod.energy_unit()),
         max_violation: viol,
         balance: crate::balance::balance(p, a, &lambda, &reactions),
@@ -361,4 +362,6 @@ pub struct Evaluation {
     pub balance: crate::balance::Balance,
     /// Self-contact forces, largest first.
     pub self_contacts: Vec<SelfContactForce>,
+    /// The least-squares multipliers (dimensionless, one per constraint row).
+    pub lambda: Vec<f64>,
 }

@@ -9,24 +9,23 @@ use dlo_planner::planner::{PlanStatus, Planner};
 use dlo_planner::statics::{SolveStatus, StaticSolution, solve_static};
 use std::path::Path;
 
-/// A 3D rod (L = 100, r = 0.5) clamped at the origin along +x and at (0, 0, 10) along −x,
-/// turned by +π in between: in the x–z plane the loop can only reach its second clamp by
-/// crossing its first leg.
+/// `planning_cases/self_contact_crossed_loop.json` (a 3D rod, L = 100, r = 0.5, clamped at the
+/// origin along +x and at (0, 0, 10) along −x, turned by +π in between: in the x–z plane the
+/// loop can only reach its second clamp by crossing its first leg), with or without
+/// self-contact.
 fn crossed_loop(self_contact: bool) -> (case::Case, StaticSolution) {
-    let text = format!(
-        r#"{{ "name": "crossed_loop", "planar": false, "self_contact": {self_contact},
-  "rod": {{ "length": 100.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0, "radius": 0.5 }},
-  "constraints": [
-    {{ "type": "orientation", "s": 0.0, "phi": 0.0, "theta": 1.5707963267948966, "psi": 0.0 }},
-    {{ "type": "position", "s": 100.0, "x": 0.0, "y": 0.0, "z": 10.0 }},
-    {{ "type": "orientation", "s": 100.0, "phi": 0.0, "theta": 4.71238898038469, "psi": 0.0 }}
-  ] }}"#
-    );
+    let text = shipped("self_contact_crossed_loop")
+        .replace(r#""self_contact": true"#, &format!(r#""self_contact": {self_contact}"#));
     let mut c = case::parse(&text, Path::new("crossed_loop.json")).unwrap();
     let a0 = c.initial.clone();
     let sol = solve_static(&mut c.problem, &a0, &c.options);
     assert_eq!(sol.status, SolveStatus::Converged, "self_contact {self_contact}");
     (c, sol)
+}
+
+fn shipped(name: &str) -> String {
+    let path = format!("{}/planning_cases/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(path).unwrap()
 }
 
 /// Smallest distance (case units) between the chords joining consecutive mesh boundaries that
@@ -86,39 +85,30 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
     assert!(f[1].abs() > 0.99 * size, "contact force not across the plane: {f:?}");
 }
 
-/// Self-contact rows that decide a plan. Start: the crossed loop of
-/// [`a_loop_that_would_cross_itself_touches_itself_instead`] (held at s = L by the controlled
-/// end), its first leg passing over the second; goal: its mirror image in the x–z plane
-/// (φ, ψ → −φ, −ψ), the first leg passing under. The straight-line path takes the legs through
-/// each other (the gap d − 2r between chords is −2r halfway: they intersect), and so does the
-/// plan made without self-contact rows. With them, the plan keeps every pair of chords 2r apart
-/// on the verification grid, which it never saw, at the same U_max (the end shapes' energy), and
-/// the end pose alone reproduces it.
+/// Self-contact rows that decide a plan (`planning_cases/plan_loop_flip.json`). Start: the
+/// crossed loop of [`a_loop_that_would_cross_itself_touches_itself_instead`] (held at s = L by
+/// the controlled end), its first leg passing over the second; goal: its mirror image in the
+/// x–z plane (φ, ψ → −φ, −ψ), the first leg passing under. The straight-line path takes the
+/// legs through each other (the gap d − 2r between chords is −2r halfway: they intersect), and
+/// so does the plan made without self-contact rows. With them, the plan keeps every pair of
+/// chords 2r apart on the verification grid, which it never saw, at the same U_max (the end
+/// shapes' energy), and the end pose alone reproduces it, from the start shape itself at k = 0
+/// (its first solve starts from the start shape's contact forces; started without them, it
+/// passed the legs through each other into the mirror image, 0.012 L away) to the goal.
 #[test]
 fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
     let (c, held) = crossed_loop(true);
+    // The shipped start is this solve's shape.
     let lay = &c.problem.model.layout;
-    let field = |f: Field, sign: f64| -> Vec<f64> {
-        lay.field(&held.a, f).unwrap().iter().map(|v| sign * v).collect()
-    };
-    let (phi, theta, psi) = (
-        field(Field::Phi, 1.0),
-        field(Field::Theta, 1.0),
-        field(Field::Psi, 1.0),
-    );
-    let (phi_m, psi_m) = (field(Field::Phi, -1.0), field(Field::Psi, -1.0));
+    let flip = case::parse(&shipped("plan_loop_flip"), Path::new("flip.json")).unwrap();
+    let start = Planner::from_case(&flip).unwrap().start.a.clone();
+    for f in [Field::Phi, Field::Theta, Field::Psi] {
+        let (a, b) = (lay.field(&held.a, f).unwrap(), lay.field(&start, f).unwrap());
+        assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + x.abs())));
+    }
     let plan = |self_contact: bool| {
-        let text = format!(
-            r#"{{ "name": "flip", "planar": false, "self_contact": {self_contact},
-  "rod": {{ "length": 100.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0, "radius": 0.5 }},
-  "constraints": [
-    {{ "type": "orientation", "s": 0.0, "phi": 0.0, "theta": 1.5707963267948966, "psi": 0.0 }}
-  ],
-  "plan": {{
-    "start": {{ "shape": {{ "phi": {phi:?}, "theta": {theta:?}, "psi": {psi:?} }} }},
-    "goal": {{ "shape": {{ "phi": {phi_m:?}, "theta": {theta:?}, "psi": {psi_m:?} }} }},
-    "k_samples": 21 }} }}"#
-        );
+        let text = shipped("plan_loop_flip")
+            .replace(r#""self_contact": true"#, &format!(r#""self_contact": {self_contact}"#));
         let c = case::parse(&text, Path::new("flip.json")).unwrap();
         let p = Planner::from_case(&c).unwrap();
         let r = p.run(&mut Silent);
@@ -130,16 +120,29 @@ fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
                 .unwrap()
         };
         let straight = gap(&vec![0.0; path.n_vars()]);
-        (r.status, r.u_max, r.replay.coincide, straight, gap(&r.z))
+        let planned = gap(&r.z);
+        (r, straight, planned)
     };
-    let (status0, u0, _, straight, (g0, k0)) = plan(false);
-    let (status1, u1, coincide1, _, (g1, k1)) = plan(true);
+    let (r0, straight, (g0, k0)) = plan(false);
+    let (r1, _, (g1, k1)) = plan(true);
     let r = c.problem.model.rod.radius;
     assert!(straight.0 < -1.9 * r, "straight-line path: gap {straight:?}");
-    assert_eq!(status0, PlanStatus::Planned);
+    assert_eq!(r0.status, PlanStatus::Planned);
     assert!(g0 < -r, "plan without the rows: gap {g0} at k = {k0}");
-    assert_eq!(status1, PlanStatus::Planned);
+    assert_eq!(r1.status, PlanStatus::Planned);
     assert!(g1 >= 0.0, "plan with the rows: gap {g1} at k = {k1}");
-    assert!((u1 - u0).abs() <= 1e-6 * u0, "U_max {u1} with the rows, {u0} without");
-    assert!(coincide1, "the end pose does not reproduce the plan with the rows");
+    assert!(
+        (r1.u_max - r0.u_max).abs() <= 1e-6 * r0.u_max,
+        "U_max {} with the rows, {} without",
+        r1.u_max,
+        r0.u_max
+    );
+    let rep = &r1.replay;
+    assert!(rep.coincide, "the end pose does not reproduce the plan: {rep:?}");
+    assert!(
+        rep.start_deviation_over_l < 1e-3 && rep.end_deviation_over_l < 1e-3,
+        "the replay does not reproduce the ends: {} and {} L",
+        rep.start_deviation_over_l,
+        rep.end_deviation_over_l
+    );
 }

@@ -135,9 +135,12 @@ fn end_shape(
             .map(|&(f, v)| (Angle::Field(f), v))
             .collect(),
     };
-    let mut p = pose.problem(base);
     let sol = if end.position.is_empty() && end.angles.is_empty() {
         let a = end.shape.clone().expect("validated: shape or pose");
+        // Held at its own end pose, as the replay holds it: the least-squares multipliers then
+        // include the end's reactions, and they warm-start the replay's first solve row for row.
+        let held = EndPose::of(&base.model, &a, &base.model.evaluate(&a).positions);
+        let mut p = held.problem(base);
         let ev = crate::statics::evaluate_shape(&mut p, &a);
         let viol = ev.max_violation;
         StaticSolution {
@@ -150,7 +153,9 @@ fn end_shape(
             } else {
                 SolveStatus::Infeasible
             },
-            lambda: vec![0.0; crate::optim::Nlp::m(&p)],
+            // The multipliers the shape needs, so that a solve warm-started from it (the
+            // replay's first step) starts with its contact forces, not without them.
+            lambda: ev.lambda,
             max_violation: viol,
             kkt_residual: ev.kkt_residual,
             reactions: ev.reactions,
@@ -163,7 +168,7 @@ fn end_shape(
         }
     } else {
         let a0 = end.shape.clone().unwrap_or_else(|| case.initial.clone());
-        solve_static(&mut p, &a0, opts)
+        solve_static(&mut pose.problem(base), &a0, opts)
     };
     if sol.status != SolveStatus::Converged {
         return Err(Error::invalid(
