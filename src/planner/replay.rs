@@ -83,6 +83,21 @@ struct State {
     positions: Vec<[f64; 3]>,
 }
 
+/// Multipliers that warm-start the solve of `p` (the base problem plus an end pose) from `from`:
+/// all of `from`'s when its rows are `p`'s, else its base rows' (the case's conditions,
+/// obstacles and self-contact come first in both) and zero for the pose rows, so that contact
+/// forces carry over even where the end pose has other rows.
+fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProblem) -> Vec<f64> {
+    let m = crate::optim::Nlp::m(p);
+    if from.lambda.len() == m {
+        return from.lambda.clone();
+    }
+    let nb = crate::optim::Nlp::m(base).min(from.lambda.len());
+    let mut l = vec![0.0; m];
+    l[..nb].copy_from_slice(&from.lambda[..nb]);
+    l
+}
+
 /// Largest distance between corresponding boundary points (dimensionless).
 pub(crate) fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     a.iter()
@@ -119,11 +134,8 @@ pub fn replay(
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
         let pose = EndPose::of(model, &target.0, &target.1);
         let mut p = pose.problem(base);
-        let mut sol = if from.sol.lambda.len() == crate::optim::Nlp::m(&p) {
-            solve_static_warm(&mut p, &from.sol.a, &from.sol.lambda, static_opts)
-        } else {
-            crate::statics::solve_static(&mut p, &from.sol.a, static_opts)
-        };
+        let lambda = warm_multipliers(base, &from.sol, &p);
+        let mut sol = solve_static_warm(&mut p, &from.sol.a, &lambda, static_opts);
         // A solve that ran out of iterations gets one more budget from where it stopped.
         if sol.status == SolveStatus::IterationLimit {
             sol = solve_static_warm(&mut p, &sol.a, &sol.lambda, static_opts);
@@ -270,11 +282,8 @@ pub fn equilibria(
             model.evaluate_into(&a, &mut shape);
             let pose = EndPose::of(model, &a, &shape.positions);
             let mut p = pose.problem(base);
-            let sol = if prev.lambda.len() == crate::optim::Nlp::m(&p) {
-                solve_static_warm(&mut p, &prev.a, &prev.lambda, &opts)
-            } else {
-                crate::statics::solve_static(&mut p, &prev.a, &opts)
-            };
+            let lambda = warm_multipliers(base, &prev, &p);
+            let sol = solve_static_warm(&mut p, &prev.a, &lambda, &opts);
             let x = model.evaluate(&sol.a).positions;
             prev = sol;
             x
