@@ -11,10 +11,8 @@
 //! its Ritz coefficients: for planar rods. For a 3D rod the Ritz space of the Euler angles is not
 //! closed under rotations about axes other than z, so the residual measures how far the
 //! discrete shape is from a full equilibrium; it shrinks as the basis grows. It does not shrink
-//! where the frame is singular (θ = 0 or π): at a clamp there the angles cannot express a tilt
-//! about one axis, so the prescribed angles' multipliers miss that moment component, and a 3D
-//! rod whose tangent passes through ±z is held there by its parametrisation as by a hidden
-//! support.
+//! where the rod's tangent passes through ±z between its ends (θ = 0 or π, where φ and ψ enter
+//! only as φ ∓ ψ): the parametrisation holds the tangent at the pole like a hidden support.
 
 use crate::constraints::{
     Bound, ObstacleConstraint, PositionConstraint, RelativePositionConstraint,
