@@ -82,7 +82,10 @@ fn a_3d_shape_balances_better_as_the_basis_grows() {
         let (r, e) = (sol.balance.relative, sol.energy.potential());
         if let Some((r0, e0)) = last {
             assert!(r < r0, "{pairs} pairs: residual {r} after {r0}");
-            assert!(e <= e0 * (1.0 + 1e-9), "{pairs} pairs: energy {e} after {e0}");
+            assert!(
+                e <= e0 * (1.0 + 1e-9),
+                "{pairs} pairs: energy {e} after {e0}"
+            );
         }
         last = Some((r, e));
         rel.push(r);

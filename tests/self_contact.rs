@@ -14,12 +14,18 @@ use std::path::Path;
 /// loop can only reach its second clamp by crossing its first leg), with or without
 /// self-contact.
 fn crossed_loop(self_contact: bool) -> (case::Case, StaticSolution) {
-    let text = shipped("self_contact_crossed_loop")
-        .replace(r#""self_contact": true"#, &format!(r#""self_contact": {self_contact}"#));
+    let text = shipped("self_contact_crossed_loop").replace(
+        r#""self_contact": true"#,
+        &format!(r#""self_contact": {self_contact}"#),
+    );
     let mut c = case::parse(&text, Path::new("crossed_loop.json")).unwrap();
     let a0 = c.initial.clone();
     let sol = solve_static(&mut c.problem, &a0, &c.options);
-    assert_eq!(sol.status, SolveStatus::Converged, "self_contact {self_contact}");
+    assert_eq!(
+        sol.status,
+        SolveStatus::Converged,
+        "self_contact {self_contact}"
+    );
     (c, sol)
 }
 
@@ -66,7 +72,11 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
     assert!(free.self_contacts.is_empty());
 
     let (gap1, lift1) = gap_and_lift(&c1, &held.a);
-    assert!(held.max_violation < 1e-8, "violation {}", held.max_violation);
+    assert!(
+        held.max_violation < 1e-8,
+        "violation {}",
+        held.max_violation
+    );
     assert!(gap1 > 1.9 * r, "legs {gap1} apart, 2r = {}", 2.0 * r);
     assert!(lift1 > r, "the loop stays in the plane ({lift1})");
     assert_eq!(held.stable, Some(true));
@@ -82,7 +92,10 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
     let f = contact.force;
     let size = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
     assert!(size > 1e-4, "contact force {f:?}");
-    assert!(f[1].abs() > 0.99 * size, "contact force not across the plane: {f:?}");
+    assert!(
+        f[1].abs() > 0.99 * size,
+        "contact force not across the plane: {f:?}"
+    );
 }
 
 /// Self-contact rows that decide a plan (`planning_cases/plan_loop_flip.json`). Start: the
@@ -103,12 +116,21 @@ fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
     let flip = case::parse(&shipped("plan_loop_flip"), Path::new("flip.json")).unwrap();
     let start = Planner::from_case(&flip).unwrap().start.a.clone();
     for f in [Field::Phi, Field::Theta, Field::Psi] {
-        let (a, b) = (lay.field(&held.a, f).unwrap(), lay.field(&start, f).unwrap());
-        assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + x.abs())));
+        let (a, b) = (
+            lay.field(&held.a, f).unwrap(),
+            lay.field(&start, f).unwrap(),
+        );
+        assert!(
+            a.iter()
+                .zip(b)
+                .all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + x.abs()))
+        );
     }
     let plan = |self_contact: bool| {
-        let text = shipped("plan_loop_flip")
-            .replace(r#""self_contact": true"#, &format!(r#""self_contact": {self_contact}"#));
+        let text = shipped("plan_loop_flip").replace(
+            r#""self_contact": true"#,
+            &format!(r#""self_contact": {self_contact}"#),
+        );
         let c = case::parse(&text, Path::new("flip.json")).unwrap();
         let p = Planner::from_case(&c).unwrap();
         let r = p.run(&mut Silent);
@@ -126,7 +148,10 @@ fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
     let (r0, straight, (g0, k0)) = plan(false);
     let (r1, _, (g1, k1)) = plan(true);
     let r = c.problem.model.rod.radius;
-    assert!(straight.0 < -1.9 * r, "straight-line path: gap {straight:?}");
+    assert!(
+        straight.0 < -1.9 * r,
+        "straight-line path: gap {straight:?}"
+    );
     assert_eq!(r0.status, PlanStatus::Planned);
     assert!(g0 < -r, "plan without the rows: gap {g0} at k = {k0}");
     assert_eq!(r1.status, PlanStatus::Planned);
@@ -138,7 +163,10 @@ fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
         r0.u_max
     );
     let rep = &r1.replay;
-    assert!(rep.coincide, "the end pose does not reproduce the plan: {rep:?}");
+    assert!(
+        rep.coincide,
+        "the end pose does not reproduce the plan: {rep:?}"
+    );
     assert!(
         rep.start_deviation_over_l < 1e-3 && rep.end_deviation_over_l < 1e-3,
         "the replay does not reproduce the ends: {} and {} L",

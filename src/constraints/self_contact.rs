@@ -85,12 +85,7 @@ impl SelfContactConstraint {
     /// every pair that pushes, the dimensionless arc lengths `(t_a, t_b)`, `t_a < t_b`, of its
     /// closest points and the force on the strand at `t_a`, along the line from the closest
     /// point at `t_b` to it (the strand at `t_b` takes the opposite force).
-    pub fn contacts(
-        &self,
-        m: &Model,
-        shape: &Shape,
-        lambda: &[f64],
-    ) -> Vec<([f64; 2], [f64; 3])> {
+    pub fn contacts(&self, m: &Model, shape: &Shape, lambda: &[f64]) -> Vec<([f64; 2], [f64; 3])> {
         let t = |b: usize| m.mesh.boundaries[b];
         let mut out = Vec::new();
         for (&li, &(i, j)) in lambda.iter().zip(&self.pairs) {
@@ -103,8 +98,9 @@ impl SelfContactConstraint {
             if d < 1e-300 {
                 continue;
             }
-            let n: [f64; 3] =
-                std::array::from_fn(|k| (p1[k] + s * (q1[k] - p1[k]) - p2[k] - u * (q2[k] - p2[k])) / d);
+            let n: [f64; 3] = std::array::from_fn(|k| {
+                (p1[k] + s * (q1[k] - p1[k]) - p2[k] - u * (q2[k] - p2[k])) / d
+            });
             let along = |c: usize, f: f64| {
                 let (a, b) = (t(self.samples[c]), t(self.samples[c + 1]));
                 a + f * (b - a)
