@@ -43,6 +43,20 @@ impl Default for Discretisation {
 /// sums in registers (four AVX2 vectors).
 pub(crate) const LANES: usize = 16;
 
+/// `rows` (each of length `n`) padded with zeros to [`LANES`], or nothing when `n > LANES`: the
+/// form in which the hot loops keep their sums in registers.
+pub(crate) fn padded<'a>(rows: impl Iterator<Item = &'a [f64]>, n: usize) -> Vec<[f64; LANES]> {
+    if n > LANES {
+        return Vec::new();
+    }
+    rows.map(|row| {
+        let mut p = [0.0; LANES];
+        p[..n].copy_from_slice(row);
+        p
+    })
+    .collect()
+}
+
 /// The rod model, ready to evaluate shapes and energies.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -134,17 +148,7 @@ impl Model {
         let transpose =
             |m: &[f64]| -> Vec<f64> { (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect() };
         let (e_rows, de_rows) = (transpose(&e), transpose(&de));
-        let e_lanes = if nb <= LANES {
-            e.chunks_exact(nb)
-                .map(|row| {
-                    let mut p = [0.0; LANES];
-                    p[..nb].copy_from_slice(row);
-                    p
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let e_lanes = padded(e.chunks_exact(nb), nb);
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
         let mut model = Model {

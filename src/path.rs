@@ -40,18 +40,7 @@ impl DeformationPath {
                 .map(|q| ns.column(q).iter().copied().collect())
                 .collect()
         };
-        let lanes = if n <= LANES {
-            basis
-                .iter()
-                .map(|col| {
-                    let mut p = [0.0; LANES];
-                    p[..n].copy_from_slice(col);
-                    p
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let lanes = crate::model::padded(basis.iter().map(Vec::as_slice), n);
         DeformationPath {
             a0,
             a1,
@@ -103,37 +92,28 @@ impl DeformationPath {
     /// [`DeformationPath::shape_at`]'s loops (compiled twice, see [`crate::wide`]).
     #[inline(always)]
     fn shape_at_body(&self, z: &[f64], k: f64, out: &mut [f64]) {
-        if !self.lanes.is_empty() {
-            // The same operations in the same order, the sums in a fixed-size array.
-            let mut acc = [0.0; LANES];
-            for ((o, &x0), &x1) in acc.iter_mut().zip(&self.a0).zip(&self.a1) {
-                *o = (1.0 - k) * x0 + k * x1;
-            }
-            let r = self.lanes.len();
-            for i in 0..self.terms {
-                let w = Self::weight(i + 1, k);
-                for (q, col) in self.lanes.iter().enumerate() {
-                    let zq = w * z[i * r + q];
-                    if zq != 0.0 {
-                        for (o, bj) in acc.iter_mut().zip(col) {
-                            *o += zq * bj;
-                        }
-                    }
-                }
-            }
-            out.copy_from_slice(&acc[..out.len()]);
-            return;
+        if self.lanes.is_empty() {
+            return self.sum_terms(&self.basis, z, k, out);
         }
+        // The same operations in the same order, the sums in a fixed-size array (registers).
+        let mut acc = [0.0; LANES];
+        self.sum_terms(&self.lanes, z, k, &mut acc);
+        out.copy_from_slice(&acc[..out.len()]);
+    }
+
+    /// `out = (1 − k) a0 + k a1 + Σᵢ kⁱ(1 − k) Σ_q z_iq col_q` over the basis columns `cols`.
+    #[inline(always)]
+    fn sum_terms<C: AsRef<[f64]>>(&self, cols: &[C], z: &[f64], k: f64, out: &mut [f64]) {
         for ((o, &x0), &x1) in out.iter_mut().zip(&self.a0).zip(&self.a1) {
             *o = (1.0 - k) * x0 + k * x1;
         }
-        let r = self.basis.len();
+        let r = cols.len();
         for i in 0..self.terms {
             let w = Self::weight(i + 1, k);
-            for (q, col) in self.basis.iter().enumerate() {
+            for (q, col) in cols.iter().enumerate() {
                 let zq = w * z[i * r + q];
                 if zq != 0.0 {
-                    for (o, bj) in out.iter_mut().zip(col) {
+                    for (o, bj) in out.iter_mut().zip(col.as_ref()) {
                         *o += zq * bj;
                     }
                 }

@@ -92,15 +92,9 @@ impl SelfContactConstraint {
             if li <= 0.0 {
                 continue;
             }
-            let (p1, q1) = self.chord(shape, i);
-            let (p2, q2) = self.chord(shape, j);
-            let (s, u, d) = segment_distance(p1, q1, p2, q2);
-            if d < 1e-300 {
+            let Some((s, u, n)) = self.closest(shape, i, j) else {
                 continue;
-            }
-            let n: [f64; 3] = std::array::from_fn(|k| {
-                (p1[k] + s * (q1[k] - p1[k]) - p2[k] - u * (q2[k] - p2[k])) / d
-            });
+            };
             let along = |c: usize, f: f64| {
                 let (a, b) = (t(self.samples[c]), t(self.samples[c + 1]));
                 a + f * (b - a)
@@ -108,6 +102,20 @@ impl SelfContactConstraint {
             out.push(([along(i, s), along(j, u)], n.map(|v| li * v)));
         }
         out
+    }
+
+    /// The closest points of chords `i` and `j` as their parameters along each chord, and the
+    /// unit vector from the point on `j` to the point on `i` (`None` where the chords meet).
+    fn closest(&self, shape: &Shape, i: usize, j: usize) -> Option<(f64, f64, [f64; 3])> {
+        let (p1, q1) = self.chord(shape, i);
+        let (p2, q2) = self.chord(shape, j);
+        let (s, t, d) = segment_distance(p1, q1, p2, q2);
+        if d < 1e-300 {
+            return None;
+        }
+        let c1: [f64; 3] = std::array::from_fn(|k| p1[k] + s * (q1[k] - p1[k]));
+        let c2: [f64; 3] = std::array::from_fn(|k| p2[k] + t * (q2[k] - p2[k]));
+        Some((s, t, std::array::from_fn(|k| (c1[k] - c2[k]) / d)))
     }
 
     fn chord(&self, shape: &Shape, i: usize) -> ([f64; 3], [f64; 3]) {
@@ -140,19 +148,9 @@ impl Constraint for SelfContactConstraint {
             if wi == 0.0 {
                 continue;
             }
-            let (p1, q1) = self.chord(shape, i);
-            let (p2, q2) = self.chord(shape, j);
-            let (s, t, d) = segment_distance(p1, q1, p2, q2);
-            if d < 1e-300 {
+            let Some((s, t, n)) = self.closest(shape, i, j) else {
                 continue;
-            }
-            let c1: Vec<f64> = (0..3).map(|k| p1[k] + s * (q1[k] - p1[k])).collect();
-            let c2: Vec<f64> = (0..3).map(|k| p2[k] + t * (q2[k] - p2[k])).collect();
-            let n = [
-                (c1[0] - c2[0]) / d,
-                (c1[1] - c2[1]) / d,
-                (c1[2] - c2[2]) / d,
-            ];
+            };
             // c = min − d: ∂c/∂x = −∂d/∂x.
             adj.add_pos(self.samples[i], -wi * (1.0 - s), n);
             adj.add_pos(self.samples[i + 1], -wi * s, n);
