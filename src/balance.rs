@@ -14,11 +14,9 @@
 //! where the rod's tangent passes through ±z between its ends (θ = 0 or π, where φ and ψ enter
 //! only as φ ∓ ψ): the parametrisation holds the tangent at the pole like a hidden support.
 
-use crate::constraints::{
-    Bound, ObstacleConstraint, PositionConstraint, RelativePositionConstraint,
-};
+use crate::kinematics::Shape;
 use crate::problem::StaticProblem;
-use crate::statics::Reaction;
+use crate::statics::{Reaction, point_forces};
 use serde::Serialize;
 
 /// The total force and moment on the rod (moments about its base point `x(0)`), in case units.
@@ -47,13 +45,18 @@ fn norm(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
-/// The moment balance of the shape `a` with multipliers `lambda` and its `reactions`
-/// ([`crate::statics::reactions`]).
-pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reaction]) -> Balance {
+/// The balance of the shape `a` (evaluated: `shape`) with multipliers `lambda` and its
+/// `reactions` ([`crate::statics::reactions`]).
+pub fn balance(
+    p: &StaticProblem,
+    a: &[f64],
+    shape: &Shape,
+    lambda: &[f64],
+    reactions: &[Reaction],
+) -> Balance {
     let m = &p.model;
     let l = m.rod.length;
     let fu = m.rod.force_unit();
-    let shape = m.evaluate(a);
     let at = |b: usize| shape.positions[b].map(|v| v * l);
     let x0 = at(0);
     let arm = |x: [f64; 3]| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
@@ -79,44 +82,16 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
     for r in reactions {
         add(r.moment, r.force, false);
     }
+    // Orientation constraints are in the reactions; self-contact pairs cancel; linear
+    // conditions join the pieces of a split basis.
     for (k, con) in p.constraints.iter().enumerate() {
         let lam = &lambda[p.rows_of(k)];
-        let any = con.as_any();
-        if let Some(pc) = any.downcast_ref::<PositionConstraint>() {
-            let mut f = [0.0; 3];
-            for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
-                let sign = if matches!(b, Bound::AtLeast(_)) {
-                    1.0
-                } else {
-                    -1.0
-                };
-                f[comp] += sign * li * fu;
-            }
-            add(cross(arm(at(pc.boundary)), f), f, true);
-        } else if let Some(rc) = any.downcast_ref::<RelativePositionConstraint>() {
-            // The reaction's force at the second point, its opposite at the first.
-            let mut f = [0.0; 3];
-            for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
-                f[comp] -= li * fu;
-            }
-            let back = f.map(|v| -v);
-            add(cross(arm(at(rc.to)), f), f, true);
-            add(cross(arm(at(rc.from)), back), back, false);
-        } else if let Some(ob) = any.downcast_ref::<ObstacleConstraint>() {
-            for (&li, &b) in lam.iter().zip(&ob.samples) {
-                if li > 0.0 {
-                    let x = at(b);
-                    let (_, n) = ob.obstacle.signed_distance(x);
-                    let f = n.map(|v| li * v * fu);
-                    add(cross(arm(x), f), f, true);
-                }
-            }
+        for (b, f, reported) in point_forces(m, shape, con.as_ref(), lam).unwrap_or_default() {
+            add(cross(arm(at(b)), f), f, reported);
         }
-        // Orientation constraints are in the reactions; self-contact pairs cancel; linear
-        // conditions join the pieces of a split basis.
     }
     for ld in &m.loads {
-        let x = m.position_at(a, ld.t).map(|v| v * l);
+        let x = m.position_at_in(a, shape, ld.t).map(|v| v * l);
         let f = ld.force.map(|v| v * fu);
         add(cross(arm(x), f), f, false);
     }
@@ -124,7 +99,7 @@ pub fn balance(p: &StaticProblem, a: &[f64], lambda: &[f64], reactions: &[Reacti
     if m.rod.weight.mean() != 0.0 {
         let mut g = [0.0; 3];
         for (&t, &w) in m.mesh.nodes.iter().zip(&m.mesh.weights) {
-            let x = m.position_at(a, t).map(|v| v * l);
+            let x = m.position_at_in(a, shape, t).map(|v| v * l);
             let mo = cross(arm(x), [-m.rod.weight.at(t) * w * l, 0.0, 0.0]);
             for (gc, v) in g.iter_mut().zip(mo) {
                 *gc += v;

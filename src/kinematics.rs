@@ -230,7 +230,11 @@ impl Model {
 
     /// Position at an arbitrary `t` (dimensionless), by Gauss quadrature of eq. (6) on `[0, t]`.
     pub fn position_at(&self, a: &[f64], t: f64) -> [f64; 3] {
-        let shape = self.evaluate(a);
+        self.position_at_in(a, &self.evaluate(a), t)
+    }
+
+    /// [`Model::position_at`] from `shape`, the evaluated shape of `a`.
+    pub fn position_at_in(&self, a: &[f64], shape: &Shape, t: f64) -> [f64; 3] {
         let j = self
             .mesh
             .boundaries

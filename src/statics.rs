@@ -3,7 +3,7 @@
 
 use crate::constraints::Angle;
 use crate::energy::EnergyTerms;
-use crate::kinematics::rotation;
+use crate::kinematics::{Shape, rotation};
 use crate::layout::Field;
 use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
 use crate::optim::second_order::reduced_hessian_eigenvalues;
@@ -64,15 +64,14 @@ pub struct SelfContactForce {
     pub force: [f64; 3],
 }
 
-/// The self-contact forces of multipliers `lambda`, largest first.
-pub fn self_contacts(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<SelfContactForce> {
+/// The self-contact forces of multipliers `lambda` on the evaluated `shape`, largest first.
+pub fn self_contacts(p: &StaticProblem, shape: &Shape, lambda: &[f64]) -> Vec<SelfContactForce> {
     let m = &p.model;
     let (l, fu) = (m.rod.length, m.rod.force_unit());
-    let shape = m.evaluate(a);
     let mut out = Vec::new();
     for (k, con) in p.constraints.iter().enumerate() {
         if let Some(sc) = downcast::<crate::constraints::SelfContactConstraint>(con.as_ref()) {
-            for (t, f) in sc.contacts(m, &shape, &lambda[p.rows_of(k)]) {
+            for (t, f) in sc.contacts(m, shape, &lambda[p.rows_of(k)]) {
                 out.push(SelfContactForce {
                     s: t.map(|v| v * l),
                     force: f.map(|v| v * fu),
@@ -163,9 +162,10 @@ fn finish(
     let mut c = vec![0.0; crate::optim::Nlp::m(p)];
     crate::optim::Nlp::values(p, &a, &mut c);
     let energy_scaled = p.terms();
-    let reactions = reactions(p, &a, &out.lambda);
-    let balance = crate::balance::balance(p, &a, &out.lambda, &reactions);
-    let self_contacts = self_contacts(p, &a, &out.lambda);
+    let shape = p.model.evaluate(&a);
+    let reactions = reactions(p, &a, &shape, &out.lambda);
+    let balance = crate::balance::balance(p, &a, &shape, &out.lambda, &reactions);
+    let self_contacts = self_contacts(p, &shape, &out.lambda);
     StaticSolution {
         balance,
         self_contacts,
@@ -185,8 +185,53 @@ fn finish(
     }
 }
 
-/// Converts multipliers into reactions (see [`Reaction`]).
-pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> {
+/// The forces on the rod (case units) that the multipliers `lam` of one constraint apply at
+/// mesh boundaries, for the kinds that act through forces at points (positions, relative
+/// positions, obstacles; `None` for the others): `(boundary, force, reported)`, where
+/// `reported` says whether the constraint's [`Reaction`] counts the force (a relative-position
+/// reaction is its force at the second point; the opposite force at the first is not).
+pub(crate) fn point_forces(
+    m: &crate::model::Model,
+    shape: &Shape,
+    con: &dyn crate::constraints::Constraint,
+    lam: &[f64],
+) -> Option<Vec<(usize, [f64; 3], bool)>> {
+    use crate::constraints::*;
+    let (fu, l) = (m.rod.force_unit(), m.rod.length);
+    if let Some(pc) = downcast::<PositionConstraint>(con) {
+        let mut f = [0.0; 3];
+        for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
+            let sign = if matches!(b, Bound::AtLeast(_)) {
+                1.0
+            } else {
+                -1.0
+            };
+            f[comp] += sign * li * fu;
+        }
+        Some(vec![(pc.boundary, f, true)])
+    } else if let Some(rc) = downcast::<RelativePositionConstraint>(con) {
+        let mut f = [0.0; 3];
+        for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
+            f[comp] -= li * fu;
+        }
+        Some(vec![(rc.to, f, true), (rc.from, f.map(|v| -v), false)])
+    } else if let Some(ob) = downcast::<ObstacleConstraint>(con) {
+        let mut out = Vec::new();
+        for (&li, &b) in lam.iter().zip(&ob.samples) {
+            if li > 0.0 {
+                let x = shape.positions[b].map(|v| v * l);
+                let (_, n) = ob.obstacle.signed_distance(x);
+                out.push((b, n.map(|nc| li * nc * fu), true));
+            }
+        }
+        Some(out)
+    } else {
+        None
+    }
+}
+
+/// Converts multipliers into reactions (see [`Reaction`]); `shape` is the evaluated shape `a`.
+pub fn reactions(p: &StaticProblem, a: &[f64], shape: &Shape, lambda: &[f64]) -> Vec<Reaction> {
     use crate::constraints::*;
 
     let m = &p.model;
@@ -204,20 +249,16 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
             moment: [0.0; 3],
             angle_torques: [0.0; 3],
         };
-        if let Some(pc) = downcast::<PositionConstraint>(con.as_ref()) {
-            r.s = Some(m.mesh.boundaries[pc.boundary] * l);
-            for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
-                let sign = if matches!(b, Bound::AtLeast(_)) {
-                    1.0
-                } else {
-                    -1.0
-                };
-                r.force[comp] += sign * li * fu;
+        if let Some(forces) = point_forces(m, shape, con.as_ref(), lam) {
+            // A single point's reaction says where it acts; an obstacle's is its total.
+            let at_point = downcast::<ObstacleConstraint>(con.as_ref()).is_none();
+            if let (true, Some(&(b, _, _))) = (at_point, forces.first()) {
+                r.s = Some(m.mesh.boundaries[b] * l);
             }
-        } else if let Some(rc) = downcast::<RelativePositionConstraint>(con.as_ref()) {
-            r.s = Some(m.mesh.boundaries[rc.to] * l);
-            for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
-                r.force[comp] -= li * fu;
+            for (_, f, _) in forces.iter().filter(|e| e.2) {
+                for (rc, fc) in r.force.iter_mut().zip(f) {
+                    *rc += fc;
+                }
             }
         } else if let Some(oc) = downcast::<OrientationConstraint>(con.as_ref()) {
             r.s = Some(oc.t * l);
@@ -237,17 +278,6 @@ pub fn reactions(p: &StaticProblem, a: &[f64], lambda: &[f64]) -> Vec<Reaction> 
             }
             r.angle_torques = torques.map(|v| v * mu);
             r.moment = least_squares_moment(m, a, oc, torques).map(|v| v * mu);
-        } else if let Some(ob) = downcast::<ObstacleConstraint>(con.as_ref()) {
-            let shape = m.evaluate(a);
-            for (&li, &b) in lam.iter().zip(&ob.samples) {
-                if li > 0.0 {
-                    let x = shape.positions[b].map(|v| v * l);
-                    let (_, n) = ob.obstacle.signed_distance(x);
-                    for (fc, nc) in r.force.iter_mut().zip(n) {
-                        *fc += li * nc * fu;
-                    }
-                }
-            }
         } else {
             continue;
         }
@@ -334,13 +364,14 @@ pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> Evaluation {
     let zero = vec![0.0; p.m()];
     let (lambda, kkt) = least_squares_multipliers(p, a, &c, &zero, 1e-7)
         .unwrap_or_else(|| (zero.clone(), kkt_residual(p, a, &zero)));
-    let reactions = reactions(p, a, &lambda);
+    let shape = p.model.evaluate(a);
+    let reactions = reactions(p, a, &shape, &lambda);
     Evaluation {
         lambda: lambda.clone(),
         energy: terms.scaled(p.model.rod.energy_unit()),
         max_violation: viol,
-        balance: crate::balance::balance(p, a, &lambda, &reactions),
-        self_contacts: self_contacts(p, a, &lambda),
+        balance: crate::balance::balance(p, a, &shape, &lambda, &reactions),
+        self_contacts: self_contacts(p, &shape, &lambda),
         reactions,
         kkt_residual: kkt,
     }
