@@ -337,34 +337,36 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
         rows(ae, &m.e_rows, &mut shape.eps);
     }
     let base = m.base_position(a);
-    shape.positions.clear();
-    shape.positions.push(base);
+    // Cumulative sums, one panel at a time (every panel has `g` nodes).
+    let g = m.mesh.gauss();
+    shape.positions.resize(m.mesh.panels() + 1, [0.0; 3]);
+    shape.positions[0] = base;
     let mut x = base;
-    let ps = &m.mesh.panel_start;
+    let out = shape.positions[1..].iter_mut();
+    let w = m.mesh.weights.chunks_exact(g);
+    let (st, ct) = (shape.sth.chunks_exact(g), shape.cth.chunks_exact(g));
     if ap.is_none() && ae.is_none() {
         // In the x–z plane, inextensible: the same sums without the zero terms.
-        for j in 0..m.mesh.panels() {
-            let r = ps[j]..ps[j + 1];
-            let nodes = m.mesh.weights[r.clone()]
-                .iter()
-                .zip(&shape.sth[r.clone()])
-                .zip(&shape.cth[r]);
-            for ((&w, &st), &ct) in nodes {
+        for (((p, w), st), ct) in out.zip(w).zip(st).zip(ct) {
+            for ((&w, &st), &ct) in w.iter().zip(st).zip(ct) {
                 x[0] += w * st;
                 x[2] += w * ct;
             }
-            shape.positions.push(x);
+            *p = x;
         }
         return;
     }
-    for j in 0..m.mesh.panels() {
-        for q in ps[j]..ps[j + 1] {
-            let w = m.mesh.weights[q] * (1.0 + shape.eps[q]);
-            x[0] += w * shape.sth[q] * shape.cph[q];
-            x[1] += w * shape.sth[q] * shape.sph[q];
-            x[2] += w * shape.cth[q];
+    let (sp, cp) = (shape.sph.chunks_exact(g), shape.cph.chunks_exact(g));
+    let eps = shape.eps.chunks_exact(g);
+    for (((((p, w), st), ct), (sp, cp)), eps) in out.zip(w).zip(st).zip(ct).zip(sp.zip(cp)).zip(eps)
+    {
+        for q in 0..g {
+            let w = w[q] * (1.0 + eps[q]);
+            x[0] += w * st[q] * cp[q];
+            x[1] += w * st[q] * sp[q];
+            x[2] += w * ct[q];
         }
-        shape.positions.push(x);
+        *p = x;
     }
 }
 

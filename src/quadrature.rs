@@ -99,6 +99,11 @@ impl Mesh {
     pub fn panels(&self) -> usize {
         self.boundaries.len() - 1
     }
+
+    /// Nodes per panel (every panel has the same number, [`Mesh::new`]'s `gauss`).
+    pub fn gauss(&self) -> usize {
+        self.panel_start[1] - self.panel_start[0]
+    }
 }
 
 #[cfg(test)]
