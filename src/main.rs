@@ -595,6 +595,17 @@ fn plan_summary(r: &PlanReport) -> String {
         rp.all_converged,
         snap_list(&rp.snaps)
     );
+    if let Some(c) = rp.min_clearance {
+        let contact = if rp.max_contact_force > 0.0 {
+            format!(
+                "leans on obstacles: largest contact force {:.4e} at k = {:.3}",
+                rp.max_contact_force, rp.k_at_max_contact_force
+            )
+        } else {
+            "touches no obstacle".to_string()
+        };
+        let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
+    }
     let _ = writeln!(
         o,
         "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",

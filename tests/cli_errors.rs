@@ -432,8 +432,16 @@ fn plan_prints_documented_json_and_exit_codes() {
         "u_max",
         "all_stable",
         "coincide",
+        "min_clearance",
+        "max_contact_force",
+        "k_at_max_contact_force",
     ];
     assert_has_keys(&v["replay"], "replay.", &keys);
+    assert_has_keys(
+        &v["replay"]["steps"][0],
+        "replay.steps[0].",
+        &["deviation", "clearance", "contact_force"],
+    );
     let keys = [
         "start",
         "status",

@@ -37,6 +37,12 @@ pub struct ReplayStep {
     pub neutral_modes: Option<usize>,
     /// Constraint violation of the solve (dimensionless).
     pub violation: f64,
+    /// Smallest surface gap `d − r` of the replayed shape to any obstacle at the rod's sample
+    /// points (case units; `None` without obstacles). Zero where the shape leans on one.
+    pub clearance: Option<f64>,
+    /// Total normal force the obstacles exert on the replayed shape (case units): the sum of
+    /// its obstacle rows' multipliers. Zero where no obstacle touches it.
+    pub contact_force: f64,
 }
 
 /// Summary of a replay.
@@ -52,6 +58,12 @@ pub struct Replay {
     pub all_stable: bool,
     /// Every static solve converged.
     pub all_converged: bool,
+    /// Smallest [`ReplayStep::clearance`] along the feasible path (`None` without obstacles).
+    pub min_clearance: Option<f64>,
+    /// Largest [`ReplayStep::contact_force`] along the feasible path, and its `k`.
+    pub max_contact_force: f64,
+    /// `k` of that largest contact force.
+    pub k_at_max_contact_force: f64,
     /// `k` where the replayed shape jumps even after refinement (snap-through).
     pub snaps: Vec<f64>,
     /// Tolerance of the verdict (fraction of `L`).
@@ -96,6 +108,19 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
     let mut l = vec![0.0; m];
     l[..nb].copy_from_slice(&from.lambda[..nb]);
     l
+}
+
+/// Total normal force (case units) the obstacles of `base` exert on a solution of a problem
+/// whose first rows are `base`'s: the sum of those obstacle rows' multipliers.
+fn contact_force(base: &StaticProblem, sol: &StaticSolution) -> f64 {
+    let fu = base.model.rod.force_unit();
+    base.constraints
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.as_any().is::<crate::constraints::ObstacleConstraint>())
+        .flat_map(|(i, _)| sol.lambda[base.rows_of(i)].iter())
+        .map(|&l| l.max(0.0) * fu)
+        .sum()
 }
 
 /// Largest distance between corresponding boundary points (dimensionless).
@@ -157,6 +182,7 @@ pub fn replay(
                   steps: &mut Vec<ReplayStep>,
                   observer: &mut dyn PlanObserver| {
         let d = max_distance(&st.positions, &target.1) * l;
+        let clearance = super::clearance(base, &st.positions);
         steps.push(ReplayStep {
             k: st.k,
             deviation: d,
@@ -168,8 +194,9 @@ pub fn replay(
             stable: st.sol.stable,
             neutral_modes: st.sol.neutral_modes,
             violation: st.sol.max_violation,
+            clearance,
+            contact_force: contact_force(base, &st.sol),
         });
-        let clearance = super::clearance(base, &st.positions);
         let opt_terms = {
             let mut sh = Shape::default();
             model.evaluate_into(&target.0, &mut sh);
@@ -239,6 +266,11 @@ pub fn replay(
     let all_converged = steps.iter().all(|s| s.converged);
     let all_stable = steps.iter().all(|s| s.stable != Some(false));
     let max_dev = dmax / l;
+    let (icf, fmax) = steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, s.contact_force))
+        .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc });
     Replay {
         max_deviation_over_l: max_dev,
         k_at_max_deviation: steps[imax].k,
@@ -248,6 +280,9 @@ pub fn replay(
             .fold(f64::NEG_INFINITY, f64::max),
         all_stable,
         all_converged,
+        min_clearance: steps.iter().filter_map(|s| s.clearance).reduce(f64::min),
+        max_contact_force: fmax,
+        k_at_max_contact_force: steps[icf].k,
         coincide: max_dev <= opts.tolerance && all_converged && snaps.is_empty(),
         snaps,
         tolerance: opts.tolerance,
