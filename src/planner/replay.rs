@@ -60,7 +60,7 @@ pub struct Replay {
     pub all_converged: bool,
     /// Smallest [`ReplayStep::clearance`] along the feasible path (`None` without obstacles).
     pub min_clearance: Option<f64>,
-    /// Largest [`ReplayStep::contact_force`] along the feasible path, and its `k`.
+    /// Largest [`ReplayStep::contact_force`] along the feasible path.
     pub max_contact_force: f64,
     /// `k` of that largest contact force.
     pub k_at_max_contact_force: f64,
@@ -258,19 +258,19 @@ pub fn replay(
             current = next;
         }
     }
-    let (imax, dmax) = steps
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, s.deviation))
-        .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc });
+    // The first step with the largest value of `f` (0 if none is positive).
+    let largest = |f: fn(&ReplayStep) -> f64| {
+        steps
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (i, f(s)))
+            .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc })
+    };
+    let (imax, dmax) = largest(|s| s.deviation);
     let all_converged = steps.iter().all(|s| s.converged);
     let all_stable = steps.iter().all(|s| s.stable != Some(false));
     let max_dev = dmax / l;
-    let (icf, fmax) = steps
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, s.contact_force))
-        .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc });
+    let (icf, fmax) = largest(|s| s.contact_force);
     Replay {
         max_deviation_over_l: max_dev,
         k_at_max_deviation: steps[imax].k,
