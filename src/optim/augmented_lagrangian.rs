@@ -187,6 +187,40 @@ fn augment_body(
     phi
 }
 
+/// The point and objective of the last [`Nlp::values`] call of one multiplier-method run. The
+/// run asks for the values at the inner minimiser's final point again — for the multiplier
+/// update and the observer, for the next inner minimisation's first step (only the multipliers
+/// and the penalty change, and they enter through [`augment`]) and for the report — and
+/// `p`'s rows, objective and state there are still those of that call, so it is not repeated.
+#[derive(Default)]
+struct LastValues {
+    x: Vec<f64>,
+    f: f64,
+    /// Calls of [`Nlp::values`] made.
+    calls: usize,
+}
+
+impl LastValues {
+    /// `p.values(x, c)`, or the last call's objective when it was at `x` (bit for bit; `c`
+    /// then still holds its rows).
+    fn at<P: Nlp>(&mut self, p: &mut P, x: &[f64], c: &mut [f64]) -> f64 {
+        let same = self.calls > 0
+            && self.x.len() == x.len()
+            && self
+                .x
+                .iter()
+                .zip(x)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            self.f = p.values(x, c);
+            self.x.clear();
+            self.x.extend_from_slice(x);
+            self.calls += 1;
+        }
+        self.f
+    }
+}
+
 /// Solves `p` from `x` (updated in place), warm-starting the multipliers from `lambda0` if given.
 pub fn augmented_lagrangian<P: Nlp>(
     p: &mut P,
@@ -194,7 +228,7 @@ pub fn augmented_lagrangian<P: Nlp>(
     lambda0: Option<&[f64]>,
     opts: AlOptions,
 ) -> AlOutcome {
-    augmented_lagrangian_observed(p, x, lambda0, opts, &mut |_| {})
+    augmented_lagrangian_observed(p, x, lambda0, opts, &mut |_, _| {})
 }
 
 /// [`augmented_lagrangian`], calling `on_outer` after every outer iteration.
@@ -203,7 +237,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     x: &mut [f64],
     lambda0: Option<&[f64]>,
     opts: AlOptions,
-    on_outer: &mut dyn FnMut(&OuterIterate),
+    on_outer: &mut dyn FnMut(&OuterIterate, &P),
 ) -> AlOutcome {
     let (n, m) = (p.n(), p.m());
     let mut lambda = lambda0.map_or(vec![0.0; m], |l| l.to_vec());
@@ -212,7 +246,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut y = vec![0.0; m];
     let mut h = Vec::new();
     let mut inner_iterations = 0;
-    let mut evaluations = 0;
+    let mut last = LastValues::default();
     let mut viol_prev = f64::INFINITY;
     let mut status = AlStatus::IterationLimit;
     let mut outer = 0;
@@ -236,12 +270,13 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             // and `hess` comes right after an `eval` at its point (the problem's state, `y` and
             // the penalty weights are that evaluation's).
             let state = std::cell::RefCell::new((&mut *p, &mut c, &mut y, &mut sw));
-            let last = std::cell::RefCell::new(&mut last_hessian);
+            let last_h = std::cell::RefCell::new(&mut last_hessian);
+            let last = &mut last;
             newton(
                 |xv, g| {
                     let mut st = state.borrow_mut();
                     let (p, c, y, sw) = &mut *st;
-                    let f = p.values(xv, c);
+                    let f = last.at(*p, xv, c);
                     let phi = augment(f, c, lam, rho, senses, y, sw);
                     if let Some(g) = g {
                         p.gradient(xv, y, g);
@@ -254,7 +289,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     p.hessian(xv, y, sw, h);
                     if dual_ok {
                         // Kept for the multiplier step, which needs ∇²Φ at the final point.
-                        let mut l = last.borrow_mut();
+                        let mut l = last_h.borrow_mut();
                         l.0.clear();
                         l.0.extend_from_slice(xv);
                         l.1.clear();
@@ -276,9 +311,10 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             let sw = &mut sw;
             let p = &mut *p;
             let senses = &senses;
+            let last = &mut last;
             bfgs(
                 |xv, g| {
-                    let f = p.values(xv, c);
+                    let f = last.at(p, xv, c);
                     let phi = augment(f, c, lam, rho, senses, y, sw);
                     p.gradient(xv, y, g);
                     phi
@@ -293,13 +329,11 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             )
         };
         inner_iterations += out.iterations;
-        evaluations += out.evaluations;
         if out.status == BfgsStatus::NumericalFailure {
             status = AlStatus::NumericalFailure;
             break;
         }
-        let f_now = p.values(x, &mut c);
-        evaluations += 1;
+        let f_now = last.at(p, x, &mut c);
         let dual_step = if dual_ok && m > 0 {
             augment(f_now, &c, &lambda, rho, &senses, &mut y, &mut sw);
             // Newton's Hessian at x used these multipliers and this penalty: it is ∇²Φ here.
@@ -328,13 +362,16 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         if let Some(l) = dual_step {
             lambda = l;
         }
-        on_outer(&OuterIterate {
-            outer,
-            f: f_now,
-            violation: viol,
-            rho,
-            x,
-        });
+        on_outer(
+            &OuterIterate {
+                outer,
+                f: f_now,
+                violation: viol,
+                rho,
+                x,
+            },
+            p,
+        );
         let inner_ok = out.grad_norm <= opts.optimality_tol
             || matches!(
                 out.status,
@@ -358,7 +395,8 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         inner_tol = (inner_tol * 0.1).max(opts.optimality_tol);
     }
     // Everything below is evaluated at x: one evaluation serves every gradient.
-    let f = p.values(x, &mut c);
+    let f = last.at(p, x, &mut c);
+    let evaluations = last.calls;
     let polished = least_squares_multipliers_at(p, x, &c, &lambda, opts.active_tol);
     let mut g = vec![0.0; n];
     p.gradient(x, &lambda, &mut g);

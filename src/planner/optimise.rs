@@ -95,40 +95,39 @@ impl Planner {
         for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
             let out = {
-                let pp = &mut p;
                 let sink = &mut *sink;
-                let mut cbuf = vec![0.0; crate::optim::Nlp::m(pp)];
-                let ks = pp.ks.clone();
-                let beta = pp.beta;
-                let mw = pp.mean_weight;
-                // The observer needs the sampled energies at the iterate: re-evaluate a cheap
-                // copy of the problem.
-                let mut probe = self.minimax_problem_at(ks.clone());
-                probe.beta = beta;
-                probe.mean_weight = mw;
-                augmented_lagrangian_observed(pp, &mut z, tally.lambda.as_deref(), al, &mut |it| {
-                    let f = crate::optim::Nlp::values(&mut probe, it.x, &mut cbuf);
-                    let u = probe.energies();
-                    let (j, &umax) = u
-                        .iter()
-                        .enumerate()
-                        .max_by(|a, b| a.1.total_cmp(b.1))
-                        .expect("samples");
-                    let mean = u.iter().sum::<f64>() / u.len() as f64;
-                    sink(
-                        Progress {
-                            start,
-                            stage,
-                            outer: it.outer,
-                            smoothed_max: (f - mw * mean) * unit,
-                            sampled_max: umax * unit,
-                            k_worst: ks[j],
-                            violation: it.violation,
-                            rho: it.rho,
-                        },
-                        probe.sampled()[j].clone(),
-                    );
-                })
+                let ks = p.ks.clone();
+                let mw = p.mean_weight;
+                // `q` is the problem evaluated at the iterate: its sampled energies and shapes
+                // are the iterate's.
+                augmented_lagrangian_observed(
+                    &mut p,
+                    &mut z,
+                    tally.lambda.as_deref(),
+                    al,
+                    &mut |it, q| {
+                        let u = q.energies();
+                        let (j, &umax) = u
+                            .iter()
+                            .enumerate()
+                            .max_by(|a, b| a.1.total_cmp(b.1))
+                            .expect("samples");
+                        let mean = u.iter().sum::<f64>() / u.len() as f64;
+                        sink(
+                            Progress {
+                                start,
+                                stage,
+                                outer: it.outer,
+                                smoothed_max: (it.f - mw * mean) * unit,
+                                sampled_max: umax * unit,
+                                k_worst: ks[j],
+                                violation: it.violation,
+                                rho: it.rho,
+                            },
+                            q.sampled()[j].clone(),
+                        );
+                    },
+                )
             };
             if tally.absorb(out) {
                 break;

@@ -73,7 +73,7 @@ impl Planner {
                 ..al
             };
             let out =
-                augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_| {});
+                augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_, _| {});
             if tally.absorb(out) {
                 break;
             }
