@@ -22,6 +22,7 @@ pub(super) fn noise(seed: u64, n: usize) -> Vec<f64> {
 }
 
 /// What the multiplier-method calls of one start have produced so far.
+#[derive(Clone)]
 pub(super) struct Tally {
     pub(super) lambda: Option<Vec<f64>>,
     pub(super) status: AlStatus,

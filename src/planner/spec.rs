@@ -115,10 +115,12 @@ fn d_mean() -> f64 {
     1.0
 }
 fn d_track() -> f64 {
-    1000.0
+    // With 1000 and three rounds, 7 of 24 random planar start–goal pairs coincided; with this
+    // and eight, 14 (every one of the 7 among them; see the README).
+    10_000.0
 }
 fn d_rounds() -> usize {
-    3
+    8
 }
 fn d_track_stop() -> f64 {
     0.1

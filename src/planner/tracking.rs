@@ -41,6 +41,9 @@ impl Planner {
         // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
         let done = self.options.track_stop * self.options.tolerance;
         let mut dev_prev = f64::INFINITY;
+        // The path before the last round, with its tally: a round that leaves the samples
+        // farther from their equilibria is undone.
+        let mut before: Option<(Vec<f64>, Tally)> = None;
         for _ in 0..self.options.track_rounds {
             let targets = replay::equilibria(
                 &inflated,
@@ -59,6 +62,17 @@ impl Planner {
             });
             // The replay's deviation, estimated on the samples.
             let dev = p.distance_to(z, &targets);
+            if dev > dev_prev
+                && let Some((z_prev, tally_prev)) = before.take()
+            {
+                z.copy_from_slice(&z_prev);
+                let evaluations = tally.evaluations;
+                *tally = Tally {
+                    evaluations,
+                    ..tally_prev
+                };
+                break;
+            }
             p.targets = Some(targets);
             // Targets that no longer move: the path already sits on its equilibria.
             if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
@@ -66,6 +80,7 @@ impl Planner {
             }
             dev_prev = dev;
             tracking_rounds += 1;
+            before = Some((z.to_vec(), tally.clone()));
             // Newton steps here in either mode: the sharpness stages have chosen the route,
             // and tracking only pulls its shapes onto their equilibria.
             let al_t = AlOptions {
