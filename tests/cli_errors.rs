@@ -451,6 +451,7 @@ fn plan_prints_documented_json_and_exit_codes() {
         "violation",
         "evaluations",
         "tracking_rounds",
+        "tracking_rounds_kept",
     ];
     assert_has_keys(&v["starts"][0], "starts[0].", &keys);
     assert!(v["timing_s"]["plan"].as_f64().unwrap() > 0.0);

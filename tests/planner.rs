@@ -832,10 +832,12 @@ fn pillar_case_3d_coincides() {
     // their equilibria (0.0074 → 0.0055 → 0.0079 L) and is undone, so the plan is the one a
     // single round gives, bit for bit.
     assert_eq!(r.starts[0].tracking_rounds, 2);
+    assert_eq!(r.starts[0].tracking_rounds_kept, 1);
     assert!(r.starts[0].tracking_rounds < p.options.track_rounds);
     let c = shipped_variant(name, |v| v["plan"]["equilibrium_rounds"] = 1.into());
     let one = Planner::from_case(&c).unwrap().run(&mut Silent);
     assert_eq!(one.starts[0].tracking_rounds, 1);
+    assert_eq!(one.starts[0].tracking_rounds_kept, 1);
     assert_eq!(one.z, r.z, "the undone round left the path changed");
     assert_eq!(
         one.replay.max_deviation_over_l,

@@ -404,6 +404,7 @@ impl Planner {
                     violation: v.run.violation,
                     evaluations: v.run.evaluations,
                     tracking_rounds: v.run.tracking_rounds,
+                    tracking_rounds_kept: v.run.tracking_rounds_kept,
                 })
                 .collect(),
             chosen_start: best,

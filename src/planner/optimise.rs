@@ -49,6 +49,7 @@ pub(super) struct StartRun {
     pub(super) sampled_max: f64,
     pub(super) evaluations: usize,
     pub(super) tracking_rounds: usize,
+    pub(super) tracking_rounds_kept: usize,
 }
 
 impl Planner {
@@ -136,10 +137,11 @@ impl Planner {
         }
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
-        let tracking_rounds = if tally.status != AlStatus::NumericalFailure {
+        let (tracking_rounds, tracking_rounds_kept) = if tally.status != AlStatus::NumericalFailure
+        {
             self.track(&mut p, &mut z, &mut tally, al)
         } else {
-            0
+            (0, 0)
         };
         crate::optim::Nlp::values(&mut p, &z, &mut c);
         let sampled_max = p
@@ -155,6 +157,7 @@ impl Planner {
             sampled_max,
             evaluations: tally.evaluations,
             tracking_rounds,
+            tracking_rounds_kept,
         }
     }
 

@@ -38,6 +38,9 @@ pub struct StartSummary {
     /// Equilibrium-tracking rounds run (at most `equilibrium_rounds`; fewer when the sampled
     /// shapes already lie on their equilibria or a round stops bringing them closer).
     pub tracking_rounds: usize,
+    /// Of those, the rounds whose result the plan keeps: a round that leaves the sampled shapes
+    /// farther from their equilibria is undone.
+    pub tracking_rounds_kept: usize,
 }
 
 /// The outcome of [`super::Planner::run`].

@@ -14,18 +14,20 @@ const TRACK_PROGRESS: f64 = 0.1;
 
 impl Planner {
     /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
-    /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran.
+    /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran
+    /// and how many of them the path keeps.
     pub(super) fn track(
         &self,
         p: &mut MinimaxProblem,
         z: &mut [f64],
         tally: &mut Tally,
         al: AlOptions,
-    ) -> usize {
+    ) -> (usize, usize) {
         if self.options.track_weight <= 0.0 {
-            return 0;
+            return (0, 0);
         }
         let mut tracking_rounds = 0;
+        let mut kept = 0;
         p.track_weight = self.options.track_weight;
         // Targets keep the optimiser's safety margin from obstacles.
         let mut inflated = self.base.clone();
@@ -71,6 +73,7 @@ impl Planner {
                     evaluations,
                     ..tally_prev
                 };
+                kept = tracking_rounds - 1;
                 break;
             }
             p.targets = Some(targets);
@@ -80,6 +83,7 @@ impl Planner {
             }
             dev_prev = dev;
             tracking_rounds += 1;
+            kept = tracking_rounds;
             before = Some((z.to_vec(), tally.clone()));
             // Newton steps here in either mode: the sharpness stages have chosen the route,
             // and tracking only pulls its shapes onto their equilibria.
@@ -93,6 +97,6 @@ impl Planner {
                 break;
             }
         }
-        tracking_rounds
+        (tracking_rounds, kept)
     }
 }
