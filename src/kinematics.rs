@@ -59,6 +59,33 @@ impl Model {
         evaluate_nodes(self, a, shape);
     }
 
+    /// Weights `ωᵢ` such that `|x_b(a) − x_b(a′)| ≤ Σᵢ ωᵢ |aᵢ − a′ᵢ|` at every mesh boundary `b`
+    /// (positions in units of L), for a rod whose positions depend on θ alone: in the x–z plane,
+    /// inextensible, with a fixed base; `None` for any other rod. A node's tangent
+    /// `(sin θ, 0, cos θ)` turns by at most `|Δθ| ≤ Σᵢ |Δaᵢ| maxₙ |eᵢ|` (n over the nodes), and a
+    /// position adds the tangents with positive weights that sum to at most `Σₙ wₙ`.
+    pub fn position_bound_weights(&self) -> Option<Vec<f64>> {
+        let lay = &self.layout;
+        if lay.spatial
+            || lay.offset(Field::Phi).is_some()
+            || lay.offset(Field::Eps).is_some()
+            || lay.base_offset().is_some()
+            || self.mesh.weights.iter().any(|&w| w < 0.0)
+        {
+            return None;
+        }
+        let ot = lay.offset(Field::Theta)?;
+        let nb = self.nb();
+        let total: f64 = self.mesh.weights.iter().sum();
+        let mut w = vec![0.0; self.n()];
+        for q in 0..self.nodes() {
+            for (wi, e) in w[ot..ot + nb].iter_mut().zip(self.e_at(q)) {
+                *wi = f64::max(*wi, total * e.abs());
+            }
+        }
+        Some(w)
+    }
+
     /// Evaluates the shape of coefficients `a`.
     pub fn evaluate(&self, a: &[f64]) -> Shape {
         let mut s = Shape::default();

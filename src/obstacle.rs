@@ -162,6 +162,13 @@ impl Obstacle {
         [g[0] / n, g[1] / n, g[2] / n]
     }
 
+    /// Whether the signed distance changes by at most `|p − q|` between any two points (true of
+    /// the solids' exact signed distance; a triangle mesh's sign comes from a point-in-mesh
+    /// test, which is not guaranteed to be consistent, so it does not count).
+    pub fn distance_is_lipschitz(&self) -> bool {
+        !matches!(self.shape, ObstacleShape::TriMesh(_))
+    }
+
     /// Signed distance only (no normal): the value of [`Obstacle::signed_distance`].
     #[inline(always)]
     pub fn signed_distance_value(&self, p: [f64; 3]) -> f64 {

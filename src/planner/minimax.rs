@@ -12,7 +12,9 @@
 //! interior sample `k_j`: each block's rows are repeated per sample. Energies are dimensionless
 //! (`Rf/L`), positions in units of `L`.
 
-use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
+use crate::constraints::{
+    Adjoint, Constraint, ObstacleConstraint, add_penalty_gauss_newton, add_weighted_curvature,
+};
 use crate::energy::Objective;
 use crate::hessian::add_rank_one;
 use crate::kinematics::Shape;
@@ -45,6 +47,9 @@ pub struct MinimaxProblem {
     /// Swept-clearance rows between consecutive interior samples, when on
     /// ([`MinimaxProblem::set_swept`]).
     swept: Option<Swept>,
+    /// Leave out the shapes of samples whose rows are certainly inactive (see
+    /// [`MinimaxProblem::set_skip_clear_samples`]).
+    skip: Option<ClearSamples>,
     interior: Vec<usize>,
     offsets: Vec<usize>,
     senses: Vec<Sense>,
@@ -56,6 +61,61 @@ pub struct MinimaxProblem {
     adj: Adjoint,
     ga: Vec<f64>,
     ha: Vec<f64>,
+}
+
+/// Below this (in the rows' units, dimensionless lengths) a row counts as certainly below
+/// zero: above the multiplier method's boundary band (1e-9) and the planner's active-row
+/// tolerance (1e-7), so that every decision the method takes on such a row is the same for any
+/// value below it.
+const CLEAR_MARGIN: f64 = 1e-6;
+
+/// What lets [`MinimaxProblem`] skip a sample's shape: on a rod whose positions depend on θ
+/// alone and whose energy is the constant quadratic form (planar, inextensible, weightless,
+/// fixed base, no loads), with obstacle rows only, a sample needs its shape only for its rows;
+/// and a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
+/// which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|` ([`Model::position_bound_weights`]). A sample whose rows
+/// all have zero multipliers and whose largest row, at the coefficients of its last evaluated
+/// shape, plus that bound is below `−CLEAR_MARGIN` keeps its last rows and skips its shape.
+#[derive(Debug)]
+struct ClearSamples {
+    /// `ωᵢ`.
+    omega: Vec<f64>,
+    /// Per sample: its rows at its last evaluated shape.
+    last: Vec<Option<LastRows>>,
+    /// Per interior sample: whether all its rows' multipliers are zero.
+    free: Vec<bool>,
+    /// Per sample: whether its shape is older than its coefficients.
+    stale: Vec<bool>,
+    /// Shapes left out so far.
+    left_out: usize,
+}
+
+/// A sample's rows at the coefficients of its last evaluated shape.
+#[derive(Clone, Debug)]
+struct LastRows {
+    a: Vec<f64>,
+    rows: Vec<f64>,
+    /// The largest row.
+    max: f64,
+}
+
+impl ClearSamples {
+    /// Whether sample `j` (interior sample `i`) may keep its last rows at coefficients `a`.
+    fn clear(&self, i: usize, j: usize, a: &[f64]) -> bool {
+        if !self.free[i] {
+            return false;
+        }
+        let Some(last) = &self.last[j] else {
+            return false;
+        };
+        let moved: f64 = self
+            .omega
+            .iter()
+            .zip(a.iter().zip(&last.a))
+            .map(|(w, (x, y))| w * (x - y).abs())
+            .sum();
+        last.max + moved < -CLEAR_MARGIN
+    }
 }
 
 impl MinimaxProblem {
@@ -96,6 +156,7 @@ impl MinimaxProblem {
             track_weight: 0.0,
             targets: None,
             swept: None,
+            skip: None,
             interior,
             offsets,
             senses,
@@ -128,6 +189,51 @@ impl MinimaxProblem {
         if let Some(sw) = &self.swept {
             self.senses
                 .extend(std::iter::repeat_n(Sense::LessEq, sw.rows()));
+        }
+    }
+
+    /// Turns on (or off) leaving out the shapes of samples that certainly keep clear of every
+    /// obstacle ([`ClearSamples`]; a planar, inextensible, weightless rod with a fixed base, no
+    /// loads, obstacle rows only — none of them a triangle mesh — and no swept rows; otherwise
+    /// it stays off). While the tracking term is set every shape is evaluated. The objective,
+    /// its gradient, its Hessian and the multiplier method's steps are the same bit for bit:
+    /// only work on rows whose penalty is certainly inactive is left out.
+    pub fn set_skip_clear_samples(&mut self, on: bool) {
+        let m = &self.model;
+        let eligible = on
+            && self.swept.is_none()
+            && m.loads.is_empty()
+            && !m.energy_roots.is_empty()
+            && self.blocks.iter().all(|b| {
+                b.as_any()
+                    .downcast_ref::<ObstacleConstraint>()
+                    .is_some_and(|o| o.obstacle.distance_is_lipschitz())
+            });
+        self.skip = match (eligible, m.position_bound_weights()) {
+            (true, Some(omega)) => Some(ClearSamples {
+                omega,
+                last: vec![None; self.ks.len()],
+                free: vec![false; self.interior.len()],
+                stale: vec![false; self.ks.len()],
+                left_out: 0,
+            }),
+            _ => None,
+        };
+    }
+
+    /// How many sampled shapes [`MinimaxProblem::values`] has left out so far (0 while leaving
+    /// them out is off).
+    pub fn shapes_left_out(&self) -> usize {
+        self.skip.as_ref().map_or(0, |sk| sk.left_out)
+    }
+
+    /// Evaluates sample `j`'s shape if [`MinimaxProblem::values`] left it out.
+    fn ensure_shape(&mut self, j: usize) {
+        if let Some(sk) = &mut self.skip
+            && sk.stale[j]
+        {
+            self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
+            sk.stale[j] = false;
         }
     }
 
@@ -210,12 +316,41 @@ impl Nlp for MinimaxProblem {
     fn sense(&self, i: usize) -> Sense {
         self.senses[i]
     }
+    fn set_multipliers(&mut self, lambda: &[f64], rho: f64) {
+        let _ = rho;
+        let per = self.rows_per_sample();
+        if let Some(sk) = &mut self.skip {
+            for (i, f) in sk.free.iter_mut().enumerate() {
+                *f = lambda
+                    .get(i * per..(i + 1) * per)
+                    .is_some_and(|l| l.iter().all(|&v| v == 0.0));
+            }
+        }
+    }
     fn values(&mut self, z: &[f64], c: &mut [f64]) -> f64 {
         let per = self.rows_per_sample();
         let mut row = 0;
+        // Shapes may be left out only while nothing but the rows reads them.
+        let light = self.targets.is_none() && self.skip.is_some();
+        let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
             self.path.shape_at(z, k, &mut self.a[j]);
-            self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
+            let interior = k > 0.0 && k < 1.0;
+            let keep = match &self.skip {
+                Some(sk) if light => !interior || sk.clear(i, j, &self.a[j]),
+                _ => false,
+            };
+            if keep {
+                if let Some(sk) = &mut self.skip {
+                    sk.stale[j] = true;
+                    sk.left_out += 1;
+                }
+            } else {
+                self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
+                if let Some(sk) = &mut self.skip {
+                    sk.stale[j] = false;
+                }
+            }
             self.gu[j].iter_mut().for_each(|g| *g = 0.0);
             let t = self.model.energy(
                 &self.a[j],
@@ -224,16 +359,43 @@ impl Nlp for MinimaxProblem {
                 Some(&mut self.gu[j]),
             );
             self.u[j] = t.value(self.objective);
-            if k > 0.0 && k < 1.0 {
-                for (b, blk) in self.blocks.iter().enumerate() {
-                    blk.values(
-                        &self.model,
-                        &self.a[j],
-                        &self.shapes[j],
-                        &mut c[row + self.offsets[b]..row + self.offsets[b + 1]],
-                    );
+            if interior {
+                let rows = &mut c[row..row + per];
+                match (&mut self.skip, keep) {
+                    (Some(sk), true) => {
+                        let last = sk.last[j].as_ref().expect("a kept sample has rows");
+                        rows.copy_from_slice(&last.rows);
+                    }
+                    (skip, _) => {
+                        for (b, blk) in self.blocks.iter().enumerate() {
+                            blk.values(
+                                &self.model,
+                                &self.a[j],
+                                &self.shapes[j],
+                                &mut rows[self.offsets[b]..self.offsets[b + 1]],
+                            );
+                        }
+                        if let Some(sk) = skip {
+                            let cmax = rows.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                            match &mut sk.last[j] {
+                                Some(last) => {
+                                    last.a.copy_from_slice(&self.a[j]);
+                                    last.rows.copy_from_slice(rows);
+                                    last.max = cmax;
+                                }
+                                none => {
+                                    *none = Some(LastRows {
+                                        a: self.a[j].clone(),
+                                        rows: rows.to_vec(),
+                                        max: cmax,
+                                    })
+                                }
+                            }
+                        }
+                    }
                 }
                 row += per;
+                i += 1;
             }
         }
         if let Some(sw) = &self.swept {
@@ -249,6 +411,14 @@ impl Nlp for MinimaxProblem {
         let _ = z;
         g.iter_mut().for_each(|v| *v = 0.0);
         let per = self.rows_per_sample();
+        // A left-out shape is needed only where some of its rows have a weight.
+        if self.skip.is_some() {
+            for i in 0..self.interior.len() {
+                if y[i * per..(i + 1) * per].iter().any(|v| *v != 0.0) {
+                    self.ensure_shape(self.interior[i]);
+                }
+            }
+        }
         let nk = self.ks.len() as f64;
         let mut row = 0;
         let n_sample_rows = self.sample_rows();
@@ -308,6 +478,9 @@ impl Nlp for MinimaxProblem {
     }
     fn hessian(&mut self, z: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
         let _ = z;
+        for i in 0..self.interior.len() {
+            self.ensure_shape(self.interior[i]);
+        }
         let nv = self.path.n_vars();
         let per = self.rows_per_sample();
         let nk = self.ks.len() as f64;

@@ -252,6 +252,7 @@ impl Planner {
         );
         p.mean_weight = self.options.mean_weight;
         p.set_swept(self.options.swept);
+        p.set_skip_clear_samples(true);
         p
     }
 

@@ -1,0 +1,108 @@
+//! The planner leaves out the shapes of sampled paths that certainly keep clear of every
+//! obstacle (`MinimaxProblem::set_skip_clear_samples`): the displacement bound it relies on, and
+//! that the optimisation is the same bit for bit with and without it.
+
+use dlo_planner::case;
+use dlo_planner::optim::{AlOptions, Nlp, augmented_lagrangian};
+use dlo_planner::planner::Planner;
+use std::path::Path;
+
+fn planner(name: &str) -> Planner {
+    let c = case::load(&Path::new("planning_cases").join(name)).unwrap();
+    Planner::from_case(&c).unwrap()
+}
+
+/// Deterministic numbers in [−1, 1].
+fn wave(n: usize, seed: f64) -> Vec<f64> {
+    (0..n).map(|i| ((i as f64 + 1.0) * seed).sin()).collect()
+}
+
+/// `|x_b(a) − x_b(a′)| ≤ Σᵢ ωᵢ |aᵢ − a′ᵢ|` at every boundary, for 300 pairs of planar shapes
+/// at distances from 1e-6 to 3 in coefficients; and the weights exist only for rods whose
+/// positions depend on θ alone.
+#[test]
+fn position_bound_weights_bound_the_displacement() {
+    let pl = planner("plan_paper_planar.json");
+    let m = &pl.base.model;
+    let omega = m
+        .position_bound_weights()
+        .expect("a planar inextensible rod");
+    let n = m.n();
+    let mut tightest: f64 = 0.0;
+    for t in 0..300 {
+        let scale = 10f64.powf(-6.0 + 6.5 * (t as f64) / 299.0);
+        let a: Vec<f64> = wave(n, 0.7 + 0.01 * t as f64)
+            .iter()
+            .map(|v| 2.0 * v)
+            .collect();
+        let d = wave(n, 1.3 + 0.017 * t as f64);
+        let b: Vec<f64> = a.iter().zip(&d).map(|(x, y)| x + scale * y).collect();
+        let (xa, xb) = (m.evaluate(&a).positions, m.evaluate(&b).positions);
+        let moved = xa
+            .iter()
+            .zip(&xb)
+            .map(|(p, q)| {
+                ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+            })
+            .fold(0.0, f64::max);
+        let bound: f64 = omega
+            .iter()
+            .zip(a.iter().zip(&b))
+            .map(|(w, (x, y))| w * (x - y).abs())
+            .sum();
+        assert!(
+            moved <= bound * (1.0 + 1e-12),
+            "pair {t}: moved {moved} > bound {bound}"
+        );
+        tightest = tightest.max(moved / bound);
+    }
+    // Not vacuous: some pair moves a boundary by more than a tenth of the bound.
+    assert!(tightest > 0.1, "{tightest}");
+    let bar = planner("plan_cable_under_bar.json");
+    assert!(bar.base.model.position_bound_weights().is_none());
+}
+
+/// The multiplier method on the paper's planning problem (the first sharpness stage, from a
+/// perturbed straight path) ends at the same path, multipliers and objective bit for bit
+/// whether the problem leaves out the shapes of samples clear of the block or not — and it
+/// does leave out most of them.
+#[test]
+fn leaving_out_clear_samples_changes_nothing() {
+    let pl = planner("plan_paper_planar.json");
+    let run = |skip: bool| {
+        let mut p = pl.minimax_problem();
+        p.set_skip_clear_samples(skip);
+        p.mean_weight = 1.0;
+        p.beta = 10.0 / 2.5466;
+        let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
+        let opts = AlOptions {
+            feasibility_tol: 1e-6,
+            optimality_tol: 1e-5,
+            rho_initial: 1e2,
+            rho_max: 1e8,
+            max_outer: 30,
+            max_inner: 300,
+            active_tol: 1e-7,
+            second_order: false,
+            max_step: f64::INFINITY,
+            newton_multipliers: false,
+        };
+        let out = augmented_lagrangian(&mut p, &mut z, None, opts);
+        (z, out, p.shapes_left_out(), p.ks.len())
+    };
+    let (z_on, on, left_out, nk) = run(true);
+    let (z_off, off, none, _) = run(false);
+    assert_eq!(none, 0);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&z_on), bits(&z_off));
+    assert_eq!(bits(&on.lambda), bits(&off.lambda));
+    assert_eq!(on.f.to_bits(), off.f.to_bits());
+    assert_eq!(on.max_violation.to_bits(), off.max_violation.to_bits());
+    assert_eq!(on.status, off.status);
+    assert_eq!(on.evaluations, off.evaluations);
+    assert!(
+        left_out * 2 > on.evaluations * nk,
+        "{left_out} of {} sampled shapes left out",
+        on.evaluations * nk
+    );
+}
