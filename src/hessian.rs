@@ -11,7 +11,7 @@
 use crate::energy::Objective;
 use crate::kinematics::Shape;
 use crate::layout::Field;
-use crate::model::Model;
+use crate::model::{LANES, Model};
 
 /// Local quantities at a node.
 const TH: usize = 0;
@@ -187,6 +187,8 @@ impl Model {
             // Planar and inextensible: only the θθ entry, `−w (S₀ sθ + S₂ cθ) e eᵀ`, the same
             // sums the general assembly does for it, without the absent quantities.
             let (n, nb) = (self.n(), self.nb());
+            // The nodes that contribute, in node order, with their weights.
+            let mut terms = Vec::with_capacity(self.nodes());
             for (j, s) in suffix.iter().enumerate() {
                 if *s == [0.0; 3] {
                     continue;
@@ -195,9 +197,13 @@ impl Model {
                     let (st, ct) = (shape.sth[q], shape.cth[q]);
                     let f = s[0] * st * shape.cph[q] + s[1] * st * shape.sph[q] + s[2] * ct;
                     let w = -self.mesh.weights[q] * (1.0 + shape.eps[q]) * f;
-                    if w == 0.0 {
-                        continue;
+                    if w != 0.0 {
+                        terms.push((q, w));
                     }
+                }
+            }
+            if self.e_lanes.is_empty() {
+                for &(q, w) in &terms {
                     let e = self.e_at(q);
                     for i in 0..nb {
                         let wi = w * e[i];
@@ -205,6 +211,22 @@ impl Model {
                             *r += wi * v;
                         }
                     }
+                }
+            } else {
+                // Row by row, each row's sums in a fixed-size array (registers) across the
+                // nodes: every entry still adds the same terms in node order.
+                for i in 0..nb {
+                    let row = &mut h[i * n..i * n + nb];
+                    let mut acc = [0.0; LANES];
+                    acc[..nb].copy_from_slice(row);
+                    for &(q, w) in &terms {
+                        let e = &self.e_lanes[q];
+                        let wi = w * e[i];
+                        for (a, &v) in acc.iter_mut().zip(e) {
+                            *a += wi * v;
+                        }
+                    }
+                    row.copy_from_slice(&acc[..nb]);
                 }
             }
             return;
