@@ -21,6 +21,7 @@ use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::{Nlp, Sense};
 use crate::path::DeformationPath;
+use crate::planner::clear_samples::ClearSamples;
 use crate::planner::swept::Swept;
 
 /// The minimax path problem.
@@ -61,61 +62,6 @@ pub struct MinimaxProblem {
     adj: Adjoint,
     ga: Vec<f64>,
     ha: Vec<f64>,
-}
-
-/// Below this (in the rows' units, dimensionless lengths) a row counts as certainly below
-/// zero: above the multiplier method's boundary band (1e-9) and the planner's active-row
-/// tolerance (1e-7), so that every decision the method takes on such a row is the same for any
-/// value below it.
-const CLEAR_MARGIN: f64 = 1e-6;
-
-/// What lets [`MinimaxProblem`] skip a sample's shape: on a rod whose positions depend on θ
-/// alone and whose energy is the constant quadratic form (planar, inextensible, weightless,
-/// fixed base, no loads), with obstacle rows only, a sample needs its shape only for its rows;
-/// and a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
-/// which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|` ([`Model::position_bound_weights`]). A sample whose rows
-/// all have zero multipliers and whose largest row, at the coefficients of its last evaluated
-/// shape, plus that bound is below `−CLEAR_MARGIN` keeps its last rows and skips its shape.
-#[derive(Debug)]
-struct ClearSamples {
-    /// `ωᵢ`.
-    omega: Vec<f64>,
-    /// Per sample: its rows at its last evaluated shape.
-    last: Vec<Option<LastRows>>,
-    /// Per interior sample: whether all its rows' multipliers are zero.
-    free: Vec<bool>,
-    /// Per sample: whether its shape is older than its coefficients.
-    stale: Vec<bool>,
-    /// Shapes left out so far.
-    left_out: usize,
-}
-
-/// A sample's rows at the coefficients of its last evaluated shape.
-#[derive(Clone, Debug)]
-struct LastRows {
-    a: Vec<f64>,
-    rows: Vec<f64>,
-    /// The largest row.
-    max: f64,
-}
-
-impl ClearSamples {
-    /// Whether sample `j` (interior sample `i`) may keep its last rows at coefficients `a`.
-    fn clear(&self, i: usize, j: usize, a: &[f64]) -> bool {
-        if !self.free[i] {
-            return false;
-        }
-        let Some(last) = &self.last[j] else {
-            return false;
-        };
-        let moved: f64 = self
-            .omega
-            .iter()
-            .zip(a.iter().zip(&last.a))
-            .map(|(w, (x, y))| w * (x - y).abs())
-            .sum();
-        last.max + moved < -CLEAR_MARGIN
-    }
 }
 
 impl MinimaxProblem {
@@ -193,11 +139,14 @@ impl MinimaxProblem {
     }
 
     /// Turns on (or off) leaving out the shapes of samples that certainly keep clear of every
-    /// obstacle ([`ClearSamples`]; a planar, inextensible, weightless rod with a fixed base, no
-    /// loads, obstacle rows only — none of them a triangle mesh — and no swept rows; otherwise
-    /// it stays off). While the tracking term is set every shape is evaluated. The objective,
-    /// its gradient, its Hessian and the multiplier method's steps are the same bit for bit:
-    /// only work on rows whose penalty is certainly inactive is left out.
+    /// obstacle (`src/planner/clear_samples.rs`; for a planar, inextensible, weightless rod with
+    /// a fixed base, no loads, obstacle rows only — none of them a triangle mesh — and no swept
+    /// rows; otherwise it stays off). A sample qualifies while its rows' multipliers
+    /// ([`Nlp::set_multipliers`]) are zero and its largest row at its last evaluated shape, plus
+    /// the most its positions can have moved since ([`Model::position_bound_weights`]), stays
+    /// below −1e-6: it keeps those rows. While the tracking term is set every shape is
+    /// evaluated. The objective, its gradient, its Hessian and the multiplier method's steps are
+    /// the same bit for bit: only work on rows whose penalty is certainly inactive is left out.
     pub fn set_skip_clear_samples(&mut self, on: bool) {
         let m = &self.model;
         let eligible = on
@@ -210,13 +159,9 @@ impl MinimaxProblem {
                     .is_some_and(|o| o.obstacle.distance_is_lipschitz())
             });
         self.skip = match (eligible, m.position_bound_weights()) {
-            (true, Some(omega)) => Some(ClearSamples {
-                omega,
-                last: vec![None; self.ks.len()],
-                free: vec![false; self.interior.len()],
-                stale: vec![false; self.ks.len()],
-                left_out: 0,
-            }),
+            (true, Some(omega)) => {
+                Some(ClearSamples::new(omega, self.ks.len(), self.interior.len()))
+            }
             _ => None,
         };
     }
@@ -320,11 +265,7 @@ impl Nlp for MinimaxProblem {
         let _ = rho;
         let per = self.rows_per_sample();
         if let Some(sk) = &mut self.skip {
-            for (i, f) in sk.free.iter_mut().enumerate() {
-                *f = lambda
-                    .get(i * per..(i + 1) * per)
-                    .is_some_and(|l| l.iter().all(|&v| v == 0.0));
-            }
+            sk.set_free(lambda, per);
         }
     }
     fn values(&mut self, z: &[f64], c: &mut [f64]) -> f64 {
@@ -362,10 +303,7 @@ impl Nlp for MinimaxProblem {
             if interior {
                 let rows = &mut c[row..row + per];
                 match (&mut self.skip, keep) {
-                    (Some(sk), true) => {
-                        let last = sk.last[j].as_ref().expect("a kept sample has rows");
-                        rows.copy_from_slice(&last.rows);
-                    }
+                    (Some(sk), true) => rows.copy_from_slice(sk.rows(j)),
                     (skip, _) => {
                         for (b, blk) in self.blocks.iter().enumerate() {
                             blk.values(
@@ -376,21 +314,7 @@ impl Nlp for MinimaxProblem {
                             );
                         }
                         if let Some(sk) = skip {
-                            let cmax = rows.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                            match &mut sk.last[j] {
-                                Some(last) => {
-                                    last.a.copy_from_slice(&self.a[j]);
-                                    last.rows.copy_from_slice(rows);
-                                    last.max = cmax;
-                                }
-                                none => {
-                                    *none = Some(LastRows {
-                                        a: self.a[j].clone(),
-                                        rows: rows.to_vec(),
-                                        max: cmax,
-                                    })
-                                }
-                            }
+                            sk.record(j, &self.a[j], rows);
                         }
                     }
                 }

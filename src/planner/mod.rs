@@ -4,6 +4,7 @@
 //! [`Planner::from_case`] solves the start and goal shapes; [`Planner::run`] optimises, verifies
 //! and replays, telling a [`PlanObserver`] every shape it computes.
 
+mod clear_samples;
 pub mod endpoints;
 pub mod minimax;
 pub mod observer;

@@ -1,0 +1,103 @@
+//! Which sampled shapes the planning objective may leave out: samples that certainly keep clear
+//! of every obstacle, by a bound on how far their positions can have moved since their shape
+//! was last evaluated (see [`crate::planner::minimax::MinimaxProblem::set_skip_clear_samples`]).
+
+/// Below this (in the rows' units, dimensionless lengths) a row counts as certainly below
+/// zero: above the multiplier method's boundary band (1e-9) and the planner's active-row
+/// tolerance (1e-7), so that every decision the method takes on such a row is the same for any
+/// value below it.
+const CLEAR_MARGIN: f64 = 1e-6;
+
+/// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's shape. On a rod whose
+/// positions depend on θ alone and whose energy is the constant quadratic form (planar,
+/// inextensible, weightless, fixed base, no loads), with obstacle rows only, a sample needs its
+/// shape only for its rows; and a row value `c = clearance − d(x)/L` changes by at most the
+/// boundary's displacement, which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|`
+/// ([`crate::model::Model::position_bound_weights`]). A sample whose rows all have zero
+/// multipliers and whose largest row, at the coefficients of its last evaluated shape, plus
+/// that bound is below `−CLEAR_MARGIN` keeps its last rows and skips its shape.
+#[derive(Debug)]
+pub(super) struct ClearSamples {
+    /// `ωᵢ`.
+    omega: Vec<f64>,
+    /// Per sample: its rows at its last evaluated shape.
+    last: Vec<Option<LastRows>>,
+    /// Per interior sample: whether all its rows' multipliers are zero.
+    free: Vec<bool>,
+    /// Per sample: whether its shape is older than its coefficients.
+    pub(super) stale: Vec<bool>,
+    /// Shapes left out so far.
+    pub(super) left_out: usize,
+}
+
+/// A sample's rows at the coefficients of its last evaluated shape.
+#[derive(Clone, Debug)]
+struct LastRows {
+    a: Vec<f64>,
+    rows: Vec<f64>,
+    /// The largest row.
+    max: f64,
+}
+
+impl ClearSamples {
+    /// Nothing recorded yet, for `samples` samples of which `interior` carry rows.
+    pub(super) fn new(omega: Vec<f64>, samples: usize, interior: usize) -> Self {
+        ClearSamples {
+            omega,
+            last: vec![None; samples],
+            free: vec![false; interior],
+            stale: vec![false; samples],
+            left_out: 0,
+        }
+    }
+
+    /// Takes in the multipliers: interior sample `i` owns rows `i·per .. (i+1)·per`.
+    pub(super) fn set_free(&mut self, lambda: &[f64], per: usize) {
+        for (i, f) in self.free.iter_mut().enumerate() {
+            *f = lambda
+                .get(i * per..(i + 1) * per)
+                .is_some_and(|l| l.iter().all(|&v| v == 0.0));
+        }
+    }
+
+    /// Records sample `j`'s rows at coefficients `a` (its shape just evaluated).
+    pub(super) fn record(&mut self, j: usize, a: &[f64], rows: &[f64]) {
+        let max = rows.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        match &mut self.last[j] {
+            Some(last) => {
+                last.a.copy_from_slice(a);
+                last.rows.copy_from_slice(rows);
+                last.max = max;
+            }
+            none => {
+                *none = Some(LastRows {
+                    a: a.to_vec(),
+                    rows: rows.to_vec(),
+                    max,
+                })
+            }
+        }
+    }
+
+    /// Sample `j`'s last recorded rows.
+    pub(super) fn rows(&self, j: usize) -> &[f64] {
+        &self.last[j].as_ref().expect("a kept sample has rows").rows
+    }
+
+    /// Whether sample `j` (interior sample `i`) may keep its last rows at coefficients `a`.
+    pub(super) fn clear(&self, i: usize, j: usize, a: &[f64]) -> bool {
+        if !self.free[i] {
+            return false;
+        }
+        let Some(last) = &self.last[j] else {
+            return false;
+        };
+        let moved: f64 = self
+            .omega
+            .iter()
+            .zip(a.iter().zip(&last.a))
+            .map(|(w, (x, y))| w * (x - y).abs())
+            .sum();
+        last.max + moved < -CLEAR_MARGIN
+    }
+}
