@@ -3,7 +3,7 @@
 //! that the optimisation is the same bit for bit with and without it.
 
 use dlo_planner::case;
-use dlo_planner::optim::{AlOptions, Nlp, augmented_lagrangian};
+use dlo_planner::optim::{Nlp, augmented_lagrangian};
 use dlo_planner::planner::Planner;
 use std::path::Path;
 
@@ -75,19 +75,7 @@ fn leaving_out_clear_samples_changes_nothing() {
         p.mean_weight = 1.0;
         p.beta = 10.0 / 2.5466;
         let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
-        let opts = AlOptions {
-            feasibility_tol: 1e-6,
-            optimality_tol: 1e-5,
-            rho_initial: 1e2,
-            rho_max: 1e8,
-            max_outer: 30,
-            max_inner: 300,
-            active_tol: 1e-7,
-            second_order: false,
-            max_step: f64::INFINITY,
-            newton_multipliers: false,
-        };
-        let out = augmented_lagrangian(&mut p, &mut z, None, opts);
+        let out = augmented_lagrangian(&mut p, &mut z, None, pl.stage_options());
         (z, out, p.shapes_left_out(), p.ks.len())
     };
     let (z_on, on, left_out, nk) = run(true);

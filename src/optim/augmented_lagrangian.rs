@@ -263,7 +263,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut dual_stepped = false;
     while outer < opts.max_outer {
         outer += 1;
-        p.set_multipliers(&lambda, rho);
+        p.set_multipliers(&lambda);
         let out = if use_newton {
             let lam = &lambda;
             let senses = &senses;

@@ -23,14 +23,14 @@ pub trait Nlp {
     /// Writes `∇f(x) + Σᵢ yᵢ ∇cᵢ(x)` into `g`, at the `x` of the last [`Nlp::values`] call.
     /// Rows with `yᵢ = 0` may be skipped.
     fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]);
-    /// The multipliers and penalty of the augmented function that the next evaluations serve
-    /// (the multiplier method calls this before each inner minimisation). A problem may use them
-    /// to skip work on inequality rows whose penalty is certainly inactive — zero multiplier and
-    /// a value certainly below zero — writing for such a row any value it knows to lie below
-    /// zero by the same margin: the augmented function, its gradient and the multiplier
-    /// update are then the same bit for bit. The default ignores them.
-    fn set_multipliers(&mut self, lambda: &[f64], rho: f64) {
-        let _ = (lambda, rho);
+    /// The multipliers of the augmented function that the next evaluations serve (the
+    /// multiplier method calls this before each inner minimisation). A problem may use them to
+    /// skip work on inequality rows whose penalty is certainly inactive — zero multiplier and a
+    /// value certainly below zero — writing for such a row any value it knows to lie below zero
+    /// by the same margin: the augmented function, its gradient and the multiplier update are
+    /// then the same bit for bit. The default ignores them.
+    fn set_multipliers(&mut self, lambda: &[f64]) {
+        let _ = lambda;
     }
     /// Whether the problem provides second derivatives ([`Nlp::hessian`]).
     fn has_hessian(&self) -> bool {

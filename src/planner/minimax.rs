@@ -261,8 +261,7 @@ impl Nlp for MinimaxProblem {
     fn sense(&self, i: usize) -> Sense {
         self.senses[i]
     }
-    fn set_multipliers(&mut self, lambda: &[f64], rho: f64) {
-        let _ = rho;
+    fn set_multipliers(&mut self, lambda: &[f64]) {
         let per = self.rows_per_sample();
         if let Some(sk) = &mut self.skip {
             sk.set_free(lambda, per);

@@ -53,6 +53,22 @@ pub(super) struct StartRun {
 }
 
 impl Planner {
+    /// The multiplier-method settings of each sharpness stage (the penalty restarts at 1e2).
+    pub fn stage_options(&self) -> AlOptions {
+        AlOptions {
+            feasibility_tol: 1e-6,
+            optimality_tol: 1e-5,
+            rho_initial: 1e2,
+            rho_max: 1e8,
+            max_outer: 30,
+            max_inner: 300,
+            active_tol: 1e-7,
+            second_order: self.options.optimiser == spec::Optimiser::Newton,
+            max_step: f64::INFINITY,
+            newton_multipliers: false,
+        }
+    }
+
     /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
     /// `sink` each outer iteration's progress and worst sampled shape as it happens.
     pub(super) fn optimise_from(
@@ -81,18 +97,7 @@ impl Planner {
             violation: f64::INFINITY,
             evaluations: 0,
         };
-        let al = AlOptions {
-            feasibility_tol: 1e-6,
-            optimality_tol: 1e-5,
-            rho_initial: 1e2,
-            rho_max: 1e8,
-            max_outer: 30,
-            max_inner: 300,
-            active_tol: 1e-7,
-            second_order: self.options.optimiser == spec::Optimiser::Newton,
-            max_step: f64::INFINITY,
-            newton_multipliers: false,
-        };
+        let al = self.stage_options();
         let mut z = z0;
         for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
