@@ -110,6 +110,21 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
     l
 }
 
+/// The static shape of `base` held at the end pose of coefficients `a` (with boundary
+/// `positions`), solved from `from`'s shape and multipliers; the problem is returned with it.
+fn solve_held(
+    base: &StaticProblem,
+    from: &StaticSolution,
+    a: &[f64],
+    positions: &[[f64; 3]],
+    opts: &StaticOptions,
+) -> (StaticProblem, StaticSolution) {
+    let mut p = EndPose::of(&base.model, a, positions).problem(base);
+    let lambda = warm_multipliers(base, from, &p);
+    let sol = solve_static_warm(&mut p, &from.a, &lambda, opts);
+    (p, sol)
+}
+
 /// Total normal force (case units) the obstacles of `base` exert on a solution of a problem
 /// whose first rows are `base`'s: the sum of those obstacle rows' multipliers.
 fn contact_force(base: &StaticProblem, sol: &StaticSolution) -> f64 {
@@ -157,10 +172,7 @@ pub fn replay(
         (a.clone(), shape.positions.clone(), u)
     };
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
-        let pose = EndPose::of(model, &target.0, &target.1);
-        let mut p = pose.problem(base);
-        let lambda = warm_multipliers(base, &from.sol, &p);
-        let mut sol = solve_static_warm(&mut p, &from.sol.a, &lambda, static_opts);
+        let (mut p, mut sol) = solve_held(base, &from.sol, &target.0, &target.1, static_opts);
         // A solve that ran out of iterations gets one more budget from where it stopped.
         if sol.status == SolveStatus::IterationLimit {
             sol = solve_static_warm(&mut p, &sol.a, &sol.lambda, static_opts);
@@ -315,10 +327,7 @@ pub fn equilibria(
         .map(|&k| {
             path.shape_at(z, k, &mut a);
             model.evaluate_into(&a, &mut shape);
-            let pose = EndPose::of(model, &a, &shape.positions);
-            let mut p = pose.problem(base);
-            let lambda = warm_multipliers(base, &prev, &p);
-            let sol = solve_static_warm(&mut p, &prev.a, &lambda, &opts);
+            let (_, sol) = solve_held(base, &prev, &a, &shape.positions, &opts);
             let x = model.evaluate(&sol.a).positions;
             prev = sol;
             x
