@@ -270,8 +270,9 @@ impl Nlp for MinimaxProblem {
     fn values(&mut self, z: &[f64], c: &mut [f64]) -> f64 {
         let per = self.rows_per_sample();
         let mut row = 0;
-        // Shapes may be left out only while nothing but the rows reads them.
-        let light = self.targets.is_none() && self.skip.is_some();
+        // Shapes may be left out only while nothing but the rows reads them (no tracking term,
+        // no swept rows, which may have been turned on after skipping was).
+        let light = self.targets.is_none() && self.swept.is_none() && self.skip.is_some();
         let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
             self.path.shape_at(z, k, &mut self.a[j]);
