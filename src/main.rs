@@ -561,10 +561,18 @@ fn plan_summary(r: &PlanReport) -> String {
             .map_or("n/a".into(), |c| format!("{c:.4e}")),
         p.violation
     );
-    if p.starts.len() > 1 {
+    if p.starts.len() + p.starts_not_run > 1 {
+        let not_run = if p.starts_not_run > 0 {
+            format!(
+                " ({} more not run: this one is estimated to coincide)",
+                p.starts_not_run
+            )
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             o,
-            "  starts: {}, chosen {}; verified U_max (sampled) {}",
+            "  starts: {}{not_run}, chosen {}; verified U_max (sampled; samples' distance to their equilibria) {}",
             p.starts.len(),
             p.chosen_start,
             p.starts
@@ -572,7 +580,10 @@ fn plan_summary(r: &PlanReport) -> String {
                 .map(|s| {
                     let clear = if s.collision_free { "" } else { ", collides" };
                     let (u, us, st) = (s.u_max, s.sampled_u_max, s.status);
-                    format!("{u:.4} ({us:.4}, {st:?}{clear})")
+                    let d = s
+                        .equilibrium_deviation
+                        .map_or("n/a".into(), |d| format!("{d:.4} L"));
+                    format!("{u:.4} ({us:.4}; {d}; {st:?}{clear})")
                 })
                 .collect::<Vec<_>>()
                 .join(", ")

@@ -50,6 +50,9 @@ pub(super) struct StartRun {
     pub(super) evaluations: usize,
     pub(super) tracking_rounds: usize,
     pub(super) tracking_rounds_kept: usize,
+    /// The samples' largest distance to their equilibria after tracking (units of L): the
+    /// replay's deviation estimated on the samples (`None` when not measured).
+    pub(super) equilibrium_deviation: Option<f64>,
 }
 
 impl Planner {
@@ -142,12 +145,12 @@ impl Planner {
         }
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
-        let (tracking_rounds, tracking_rounds_kept) = if tally.status != AlStatus::NumericalFailure
-        {
-            self.track(&mut p, &mut z, &mut tally, al)
-        } else {
-            (0, 0)
-        };
+        let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) =
+            if tally.status != AlStatus::NumericalFailure {
+                self.track(&mut p, &mut z, &mut tally, al)
+            } else {
+                (0, 0, None)
+            };
         crate::optim::Nlp::values(&mut p, &z, &mut c);
         let sampled_max = p
             .energies()
@@ -163,16 +166,17 @@ impl Planner {
             evaluations: tally.evaluations,
             tracking_rounds,
             tracking_rounds_kept,
+            equilibrium_deviation,
         }
     }
 
-    /// Optimises from each of `starts` (perturbations of the straight-line path) on the samples
-    /// `uniform`, then verifies and refines each plan with `check` ([`Planner::refine`]), on
-    /// parallel threads when there are several starts, telling `observer` their progress as it
-    /// happens.
+    /// Optimises from each of `starts` (start index and perturbation of the straight-line path)
+    /// on the samples `uniform`, then verifies and refines each plan with `check`
+    /// ([`Planner::refine`]), on parallel threads when there are several starts, telling
+    /// `observer` their progress as it happens.
     pub(super) fn optimise_starts(
         &self,
-        starts: &[Vec<f64>],
+        starts: &[(usize, Vec<f64>)],
         uniform: &[f64],
         check: &(dyn Fn(&[f64]) -> Verification + Sync),
         observer: &mut dyn PlanObserver,
@@ -180,8 +184,9 @@ impl Planner {
         let model = &self.base.model;
         if starts.len() == 1 {
             let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
-            let run = self.optimise_from(0, starts[0].clone(), uniform, 0, &mut sink);
-            vec![self.refine(0, run, uniform, check, &mut sink)]
+            let (i, z0) = starts[0].clone();
+            let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
+            vec![self.refine(i, run, uniform, check, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
@@ -206,10 +211,10 @@ impl Planner {
                                 let _ = tx.send((p, w));
                             };
                             idx.into_iter()
-                                .map(|i| {
-                                    let z0 = starts[i].clone();
+                                .map(|j| {
+                                    let (i, z0) = starts[j].clone();
                                     let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
-                                    (i, self.refine(i, run, uniform, check, &mut sink))
+                                    (j, self.refine(i, run, uniform, check, &mut sink))
                                 })
                                 .collect::<Vec<_>>()
                         })

@@ -41,6 +41,10 @@ pub struct StartSummary {
     /// Of those, the rounds whose result the plan keeps: a round that leaves the sampled shapes
     /// farther from their equilibria is undone.
     pub tracking_rounds_kept: usize,
+    /// The start's sampled shapes' largest distance to the equilibria their end poses produce,
+    /// after tracking (fraction of L): the replay's deviation estimated on the samples, which
+    /// decides whether a further group of starts runs (`null` when not measured).
+    pub equilibrium_deviation: Option<f64>,
 }
 
 /// The outcome of [`super::Planner::run`].
@@ -67,9 +71,13 @@ pub struct PlanResult {
     pub violation: f64,
     /// Verification details of the plan.
     pub verification: Verification,
-    /// Every start.
+    /// Every start that ran.
     pub starts: Vec<StartSummary>,
-    /// The start the plan comes from (the lowest sampled `U_max` among the feasible ones).
+    /// Starts of the case that did not run: with `parallel_starts` below `starts`, a group of
+    /// starts runs only when no earlier start's plan is estimated to coincide.
+    pub starts_not_run: usize,
+    /// The start the plan comes from: collision-free first, then feasible on the samples, then
+    /// estimated to coincide, then the lowest verified `U_max`.
     pub chosen_start: usize,
     /// Path vectors `cᵢ` (coefficient space).
     pub path: Vec<Vec<f64>>,

@@ -50,6 +50,9 @@ pub struct PlanSpec {
     /// collision-free one with the lowest verified `U_max` wins).
     #[serde(default = "d_starts")]
     pub starts: usize,
+    /// Starts run side by side in groups of this many; a group runs only when no plan of an
+    /// earlier group is estimated to coincide with its replay (default: all starts at once).
+    pub parallel_starts: Option<usize>,
     /// Seed of the starts' pseudo-random perturbations.
     #[serde(default = "d_seed")]
     pub seed: u64,
@@ -226,6 +229,9 @@ pub struct PlanOptions {
     pub sharpness: Vec<f64>,
     /// Number of starts.
     pub starts: usize,
+    /// Starts run side by side; the next group only when no earlier plan is estimated to
+    /// coincide.
+    pub parallel_starts: usize,
     /// Seed.
     pub seed: u64,
     /// Perturbation of extra starts (radians).
@@ -347,6 +353,16 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
             return Err(v.err(field, format!("must be in {lo}..={hi}, got {val}")));
         }
     }
+    let parallel_starts = spec.parallel_starts.unwrap_or(spec.starts);
+    if !(1..=spec.starts).contains(&parallel_starts) {
+        return Err(v.err(
+            "plan.parallel_starts",
+            format!(
+                "must be in 1..=plan.starts ({}), got {parallel_starts}",
+                spec.starts
+            ),
+        ));
+    }
     let safety = spec.safety_margin.unwrap_or(l / 100.0);
     if v.finite("plan.safety_margin", safety)? < 0.0 {
         return Err(v.err("plan.safety_margin", "must be non-negative"));
@@ -406,6 +422,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         track_stop: stop,
         sharpness: spec.sharpness,
         starts: spec.starts,
+        parallel_starts,
         seed: spec.seed,
         spread: spec.start_spread,
         sample_refinements: spec.sample_refinements,

@@ -14,18 +14,21 @@ const TRACK_PROGRESS: f64 = 0.1;
 
 impl Planner {
     /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
-    /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran
-    /// and how many of them the path keeps.
+    /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran,
+    /// how many of them the path keeps, and the kept path's samples' largest distance to their
+    /// equilibria (units of L; `None` when it was not measured: no tracking, a numerical
+    /// failure, or the rounds' budget spent).
     pub(super) fn track(
         &self,
         p: &mut MinimaxProblem,
         z: &mut [f64],
         tally: &mut Tally,
         al: AlOptions,
-    ) -> (usize, usize) {
+    ) -> (usize, usize, Option<f64>) {
         if self.options.track_weight <= 0.0 {
-            return (0, 0);
+            return (0, 0, None);
         }
+        let mut estimate = None;
         let mut tracking_rounds = 0;
         let mut kept = 0;
         p.track_weight = self.options.track_weight;
@@ -74,11 +77,13 @@ impl Planner {
                     ..tally_prev
                 };
                 kept = tracking_rounds - 1;
+                estimate = Some(dev_prev);
                 break;
             }
             p.targets = Some(targets);
             // Targets that no longer move: the path already sits on its equilibria.
             if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
+                estimate = Some(dev);
                 break;
             }
             dev_prev = dev;
@@ -97,6 +102,6 @@ impl Planner {
                 break;
             }
         }
-        (tracking_rounds, kept)
+        (tracking_rounds, kept, estimate)
     }
 }
