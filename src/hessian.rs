@@ -263,9 +263,16 @@ impl Model {
     /// Jacobian of the position at mesh boundary `b`: the Gauss–Newton Hessian of
     /// `½ Σ_b c[b] |x(b) − x̄_b|²`.
     pub fn add_positions_gauss_newton(&self, shape: &Shape, c: &[f64], h: &mut [f64]) {
+        let lay = &self.layout;
+        if lay.offset(Field::Phi).is_none()
+            && lay.offset(Field::Eps).is_none()
+            && lay.base_offset().is_none()
+        {
+            planar_gauss_newton(self, shape, c, h);
+            return;
+        }
         let n = self.n();
         let nb = self.nb();
-        let lay = &self.layout;
         let op = lay.offset(Field::Phi);
         let oe = lay.offset(Field::Eps);
         let mut jac = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
@@ -314,8 +321,47 @@ impl Model {
     }
 }
 
+impl Model {
+    /// [`Model::add_positions_gauss_newton`] for a planar inextensible rod with a fixed base
+    /// (compiled twice, see [`crate::wide`]): there `sin φ = 0`, `cos φ = 1` and `ε = 0`, so
+    /// the Jacobian's y row is zero and its x and z rows gain `w cos θ eᵢ` and `−w sin θ eᵢ` per
+    /// node — the general assembly's products, which it computes as `(w · (1 · cos θ · 1)) eᵢ`
+    /// and `(w · (−1 · sin θ)) eᵢ`, the same numbers — and the rank-one updates add the x row's
+    /// terms, then the z row's, as it does (its zero y row adds nothing).
+    #[inline(always)]
+    fn planar_gauss_newton_body(&self, shape: &Shape, c: &[f64], h: &mut [f64]) {
+        let n = self.n();
+        let nb = self.nb();
+        let ps = &self.mesh.panel_start;
+        let mut jx = vec![0.0; n];
+        let mut jz = vec![0.0; n];
+        // The base's Jacobian is zero: `c[0]` adds nothing.
+        for j in 0..self.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q];
+                let (wx, wz) = (w * shape.cth[q], w * -shape.sth[q]);
+                let e = self.e_at(q);
+                for ((x, z), ei) in jx[..nb].iter_mut().zip(&mut jz[..nb]).zip(e) {
+                    *x += wx * ei;
+                    *z += wz * ei;
+                }
+            }
+            let cj = c[j + 1];
+            if cj != 0.0 {
+                add_rank_one(h, cj, &jx);
+                add_rank_one(h, cj, &jz);
+            }
+        }
+    }
+}
+
+crate::wide::dispatch! {
+    fn planar_gauss_newton(m: &Model, shape: &Shape, c: &[f64], h: &mut [f64]) => Model::planar_gauss_newton_body
+}
+
 /// Adds `w · g gᵀ` to the row-major `n×n` matrix `h` (`n = g.len()`); rows where `w gₐ = 0`
 /// are skipped.
+#[inline(always)]
 pub fn add_rank_one(h: &mut [f64], w: f64, g: &[f64]) {
     let n = g.len();
     for (a, &ga) in g.iter().enumerate() {
@@ -456,7 +502,8 @@ mod tests {
 
     #[test]
     fn positions_gauss_newton_matches_jacobians() {
-        for (spatial, extensible) in [(false, true), (true, true)] {
+        // (false, false): the planar inextensible assembly.
+        for (spatial, extensible) in [(false, false), (false, true), (true, true)] {
             let m = model(spatial, extensible);
             let n = m.n();
             let sh = m.evaluate(&coefficients(n));

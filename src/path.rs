@@ -124,11 +124,18 @@ impl DeformationPath {
     /// Adds the chain rule `∂a(z, k)/∂z ᵀ · grad_a` to `grad_z`.
     pub fn add_chain(&self, grad_a: &[f64], k: f64, grad_z: &mut [f64]) {
         let r = self.basis.len();
-        let proj: Vec<f64> = self
-            .basis
-            .iter()
-            .map(|col| crate::basis::dot(col, grad_a))
-            .collect();
+        // The projections, on the stack for up to 32 unknowns per path term.
+        let mut stack = [0.0; 32];
+        let mut heap = Vec::new();
+        let proj: &mut [f64] = if r <= stack.len() {
+            &mut stack[..r]
+        } else {
+            heap.resize(r, 0.0);
+            &mut heap
+        };
+        for (p, col) in proj.iter_mut().zip(&self.basis) {
+            *p = crate::basis::dot(col, grad_a);
+        }
         for i in 0..self.terms {
             let w = Self::weight(i + 1, k);
             for q in 0..r {
