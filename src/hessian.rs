@@ -361,7 +361,6 @@ crate::wide::dispatch! {
 
 /// Adds `w · g gᵀ` to the row-major `n×n` matrix `h` (`n = g.len()`); rows where `w gₐ = 0`
 /// are skipped.
-#[inline(always)]
 pub fn add_rank_one(h: &mut [f64], w: f64, g: &[f64]) {
     let n = g.len();
     for (a, &ga) in g.iter().enumerate() {
