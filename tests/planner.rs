@@ -271,8 +271,13 @@ fn paper_replay_coincides_from_other_starts() {
 fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let (p, r) = paper();
     assert_eq!(p.options.parallel_starts, 1);
-    assert_eq!((r.starts.len(), r.starts_not_run, r.chosen_start), (1, 1, 0));
-    let est = r.starts[0].equilibrium_deviation.expect("tracking measured it");
+    assert_eq!(
+        (r.starts.len(), r.starts_not_run, r.chosen_start),
+        (1, 1, 0)
+    );
+    let est = r.starts[0]
+        .equilibrium_deviation
+        .expect("tracking measured it");
     assert!(est <= p.options.tolerance, "{est}");
     assert!(
         (est - r.replay.max_deviation_over_l).abs() < 1e-6,
@@ -281,7 +286,10 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     );
 
     let r5 = paper_with(serde_json::json!({ "seed": 5 }));
-    assert_eq!((r5.starts.len(), r5.starts_not_run, r5.chosen_start), (2, 0, 1));
+    assert_eq!(
+        (r5.starts.len(), r5.starts_not_run, r5.chosen_start),
+        (2, 0, 1)
+    );
     let first = r5.starts[0].equilibrium_deviation.expect("measured");
     assert!(first > 0.02, "{first}");
     assert!(r5.starts[1].equilibrium_deviation.expect("measured") <= 0.02);
@@ -609,7 +617,10 @@ fn bad_planning_inputs_name_the_field() {
             swing_with(r#""starts": 2, "parallel_starts": 3"#),
             "plan.parallel_starts",
         ),
-        (swing_with(r#""parallel_starts": 0"#), "plan.parallel_starts"),
+        (
+            swing_with(r#""parallel_starts": 0"#),
+            "plan.parallel_starts",
+        ),
         (
             plan_text(r#"{ "x": 0.3, "z": 0.9 }"#, r#"{ "x": 1.5, "z": 0.9 }"#, ""),
             "plan.goal",
