@@ -332,8 +332,10 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
         }
     }
     shape.constant = constant;
-    // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time.
-    let rows = |c: &[f64], m: &[f64], out: &mut [f64]| {
+    // Each field at every node: `Σᵢ aᵢ eᵢ(t_q)`, one scaled basis row at a time (a function
+    // forced inline, so that the wide copy of this body holds the wide loop).
+    #[inline(always)]
+    fn rows(nn: usize, c: &[f64], m: &[f64], out: &mut [f64]) {
         let mut rows = c.iter().zip(m.chunks_exact(nn));
         let Some((&c0, row0)) = rows.next() else {
             return out.iter_mut().for_each(|v| *v = 0.0);
@@ -346,7 +348,8 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
                 *v += ci * r;
             }
         }
-    };
+    }
+    let rows = |c: &[f64], m: &[f64], out: &mut [f64]| rows(nn, c, m, out);
     rows(at, &m.e_rows, &mut shape.th);
     if curvature {
         rows(at, &m.de_rows, &mut shape.dth);
