@@ -42,7 +42,7 @@ fn benches(c: &mut Criterion) {
         })
     });
     let r = pl.run(&mut Silent);
-    let path = pl.path();
+    let path = pl.with_terms(r.path_terms).path();
     let opts = ReplayOptions {
         steps: pl.options.replay_steps,
         refinements: pl.options.refinements,

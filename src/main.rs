@@ -562,6 +562,11 @@ fn plan_summary(r: &PlanReport) -> String {
         p.violation
     );
     if p.starts.len() + p.starts_not_run > 1 {
+        // Starts with fallback path terms ran: say which count each start used.
+        let fallback = p
+            .starts
+            .iter()
+            .any(|s| s.path_terms != p.starts[0].path_terms);
         let not_run = if p.starts_not_run > 0 {
             format!(
                 " ({} more not run: this one is estimated to coincide)",
@@ -572,9 +577,10 @@ fn plan_summary(r: &PlanReport) -> String {
         };
         let _ = writeln!(
             o,
-            "  starts: {}{not_run}, chosen {}; verified U_max (sampled; samples' distance to their equilibria) {}",
+            "  starts: {}{not_run}, chosen {} (path terms {}); verified U_max (sampled; samples' distance to their equilibria) {}",
             p.starts.len(),
             p.chosen_start,
+            p.path_terms,
             p.starts
                 .iter()
                 .map(|s| {
@@ -583,7 +589,12 @@ fn plan_summary(r: &PlanReport) -> String {
                     let d = s
                         .equilibrium_deviation
                         .map_or("n/a".into(), |d| format!("{d:.4} L"));
-                    format!("{u:.4} ({us:.4}; {d}; {st:?}{clear})")
+                    let m = if fallback {
+                        format!("m = {}: ", s.path_terms)
+                    } else {
+                        String::new()
+                    };
+                    format!("{m}{u:.4} ({us:.4}; {d}; {st:?}{clear})")
                 })
                 .collect::<Vec<_>>()
                 .join(", ")

@@ -13,6 +13,7 @@ mod refine;
 pub mod replay;
 pub mod result;
 pub mod spec;
+mod starts;
 pub mod swept;
 mod tracking;
 pub mod verify;
@@ -37,7 +38,6 @@ use spec::{End, PlanOptions};
 use std::sync::Arc;
 use verify::{fine_model, verify_with};
 
-use optimise::noise;
 use refine::Verified;
 pub use result::{PlanResult, PlanStatus, StartSummary, Timing};
 
@@ -326,59 +326,38 @@ impl Planner {
         }
 
         observer.phase("optimise");
-        let starts: Vec<(usize, Vec<f64>)> = (0..self.options.starts)
-            .map(|s| {
-                let amp = if s == 0 { 1e-2 } else { self.options.spread };
-                let z0 = noise(self.options.seed.wrapping_add(s as u64), nv)
-                    .into_iter()
-                    .map(|v| amp * v)
-                    .collect();
-                (s, z0)
-            })
+        let fallbacks: Vec<Planner> = self
+            .options
+            .fallback_terms
+            .iter()
+            .map(|&t| self.with_terms(t))
             .collect();
-        let nk = self.options.k_samples;
-        let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let tol = 1e-6 * model.rod.length;
+        let runs = self.run_starts(&fallbacks, &fine, observer);
         // The plan is the start whose verified path is best: collision-free first, then feasible
         // on the samples, then estimated to coincide with its replay, then the lower true U_max,
         // the lower sampled maximum, the lower index.
-        let coincides = |r: &Verified| {
-            r.run
-                .equilibrium_deviation
-                .is_some_and(|d| d <= self.options.tolerance)
-        };
-        let class = |r: &Verified| {
-            (
-                r.verification.collision_free(tol),
-                r.run.violation <= 1e-6,
-                coincides(r),
-            )
-        };
-        // Groups of `parallel_starts` starts; the next group runs only while no plan so far is
-        // collision-free, feasible and estimated to coincide.
-        let mut runs: Vec<Verified> = Vec::new();
-        for group in starts.chunks(self.options.parallel_starts) {
-            if runs.iter().any(|r| class(r) == (true, true, true)) {
-                break;
-            }
-            runs.extend(self.optimise_starts(group, &uniform, &check, observer));
-        }
         let best = (0..runs.len())
             .max_by(|&i, &j| {
-                let (a, b) = (&runs[i], &runs[j]);
-                class(a)
-                    .cmp(&class(b))
+                let (a, b) = (&runs[i].plan, &runs[j].plan);
+                self.class(a, tol)
+                    .cmp(&self.class(b, tol))
                     .then(b.verification.u_max.total_cmp(&a.verification.u_max))
                     .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
                     .then(j.cmp(&i))
             })
             .expect("at least one start");
         observer.phase("select");
+        let chosen_planner = match runs[best].attempt {
+            0 => self,
+            a => &fallbacks[a - 1],
+        };
+        let path = chosen_planner.path();
         let Verified {
             run: chosen,
             verification: ver,
             added,
-        } = runs[best].clone();
+        } = runs[best].plan.clone();
         let chosen = &chosen;
         let t_plan = t0.elapsed().as_secs_f64();
 
@@ -417,22 +396,29 @@ impl Planner {
             violation: chosen.violation,
             starts: runs
                 .iter()
-                .enumerate()
-                .map(|(i, v)| StartSummary {
-                    start: i,
-                    status: v.run.status,
-                    sampled_u_max: v.run.sampled_max,
-                    u_max: v.verification.u_max,
-                    collision_free: v.verification.collision_free(tol),
-                    violation: v.run.violation,
-                    evaluations: v.run.evaluations,
-                    tracking_rounds: v.run.tracking_rounds,
-                    tracking_rounds_kept: v.run.tracking_rounds_kept,
-                    equilibrium_deviation: v.run.equilibrium_deviation,
+                .map(|r| {
+                    let v = &r.plan;
+                    StartSummary {
+                        start: r.index,
+                        path_terms: match r.attempt {
+                            0 => self.options.terms,
+                            a => self.options.fallback_terms[a - 1],
+                        },
+                        status: v.run.status,
+                        sampled_u_max: v.run.sampled_max,
+                        u_max: v.verification.u_max,
+                        collision_free: v.verification.collision_free(tol),
+                        violation: v.run.violation,
+                        evaluations: v.run.evaluations,
+                        tracking_rounds: v.run.tracking_rounds,
+                        tracking_rounds_kept: v.run.tracking_rounds_kept,
+                        equilibrium_deviation: v.run.equilibrium_deviation,
+                    }
                 })
                 .collect(),
-            starts_not_run: self.options.starts - runs.len(),
-            chosen_start: best,
+            starts_not_run: self.options.starts - runs.iter().filter(|r| r.attempt == 0).count(),
+            path_terms: chosen_planner.options.terms,
+            chosen_start: runs[best].index,
             path: path.c_vectors(&chosen.z),
             added_samples: added,
             z: chosen.z.clone(),

@@ -21,8 +21,10 @@ pub enum PlanStatus {
 /// Summary of one optimiser start.
 #[derive(Clone, Debug, Serialize)]
 pub struct StartSummary {
-    /// Start index.
+    /// Start index (the case's starts first, then each fallback path-term count's).
     pub start: usize,
+    /// Path terms `m` of the start's path.
+    pub path_terms: usize,
     /// Final optimiser status.
     pub status: AlStatus,
     /// Largest sampled energy (case units).
@@ -76,12 +78,15 @@ pub struct PlanResult {
     /// Starts of the case that did not run: with `parallel_starts` below `starts`, a group of
     /// starts runs only when no earlier start's plan is estimated to coincide.
     pub starts_not_run: usize,
+    /// Path terms `m` of the plan: the case's `path_terms`, or the fallback count its start
+    /// used.
+    pub path_terms: usize,
     /// The start the plan comes from: collision-free first, then feasible on the samples, then
     /// estimated to coincide, then the lowest verified `U_max`.
     pub chosen_start: usize,
     /// Path vectors `cᵢ` (coefficient space).
     pub path: Vec<Vec<f64>>,
-    /// The unknowns `z`.
+    /// The unknowns `z` of the plan's path, `planner.with_terms(path_terms).path()`.
     #[serde(skip)]
     pub z: Vec<f64>,
     /// Feasibility replay.

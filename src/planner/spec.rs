@@ -17,6 +17,10 @@ pub struct PlanSpec {
     /// Path terms `m` (paper: 3).
     #[serde(default = "d_terms")]
     pub path_terms: usize,
+    /// Path-term counts tried in turn, with the same starts, while no plan so far is estimated
+    /// to coincide with its replay (default: none).
+    #[serde(default)]
+    pub fallback_path_terms: Vec<usize>,
     /// Samples of `k` seen by the optimiser, including 0 and 1.
     #[serde(default = "d_k")]
     pub k_samples: usize,
@@ -209,6 +213,8 @@ pub struct PlanOptions {
     pub goal: End,
     /// Path terms `m`.
     pub terms: usize,
+    /// Path-term counts tried in turn while no plan is estimated to coincide.
+    pub fallback_terms: Vec<usize>,
     /// Optimiser `k` samples (including ends).
     pub k_samples: usize,
     /// Verification `k` samples.
@@ -353,6 +359,14 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
             return Err(v.err(field, format!("must be in {lo}..={hi}, got {val}")));
         }
     }
+    for (i, &t) in spec.fallback_path_terms.iter().enumerate() {
+        if !(1..=12).contains(&t) {
+            return Err(v.err(
+                format!("plan.fallback_path_terms[{i}]"),
+                format!("must be in 1..=12, got {t}"),
+            ));
+        }
+    }
     let parallel_starts = spec.parallel_starts.unwrap_or(spec.starts);
     if !(1..=spec.starts).contains(&parallel_starts) {
         return Err(v.err(
@@ -412,6 +426,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         start,
         goal,
         terms: spec.path_terms,
+        fallback_terms: spec.fallback_path_terms,
         k_samples: spec.k_samples,
         verify_k: spec.verify_k_samples,
         verify_s: spec.verify_s_samples,

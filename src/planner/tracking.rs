@@ -16,8 +16,8 @@ impl Planner {
     /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
     /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran,
     /// how many of them the path keeps, and the kept path's samples' largest distance to their
-    /// equilibria (units of L; `None` when it was not measured: no tracking, a numerical
-    /// failure, or the rounds' budget spent).
+    /// equilibria (units of L; `None` when it was not measured: no tracking, or a numerical
+    /// failure).
     pub(super) fn track(
         &self,
         p: &mut MinimaxProblem,
@@ -29,6 +29,7 @@ impl Planner {
             return (0, 0, None);
         }
         let mut estimate = None;
+        let mut failed = false;
         let mut tracking_rounds = 0;
         let mut kept = 0;
         p.track_weight = self.options.track_weight;
@@ -99,8 +100,22 @@ impl Planner {
             let out =
                 augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_, _| {});
             if tally.absorb(out) {
+                failed = true;
                 break;
             }
+        }
+        // The rounds' budget spent (or none allowed): measure the kept path's samples once
+        // more, so that the estimate is there for choosing among starts.
+        if estimate.is_none() && !failed {
+            let targets = replay::equilibria(
+                &inflated,
+                &self.start,
+                &p.path,
+                z,
+                &p.ks,
+                &self.static_options,
+            );
+            estimate = Some(p.distance_to(z, &targets));
         }
         (tracking_rounds, kept, estimate)
     }

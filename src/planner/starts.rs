@@ -1,0 +1,104 @@
+//! Which starts run: groups of `parallel_starts` starts side by side, first with the case's path
+//! terms and then with each of `fallback_path_terms`, until a start's plan is collision-free,
+//! feasible on its samples and estimated to coincide with its replay; and which of the plans is
+//! the plan.
+
+use super::Planner;
+use super::observer::PlanObserver;
+use super::optimise::noise;
+use super::refine::Verified;
+use super::verify::verify_with;
+use crate::model::Model;
+
+/// One start's verified plan and the path-term count it was planned with.
+#[derive(Clone)]
+pub(super) struct StartPlan {
+    /// Index among the starts that ran: the case's own starts first (`0..starts`), then each
+    /// fallback count's (`starts..2·starts`, …).
+    pub(super) index: usize,
+    /// Which path-term count: 0 the case's own, `i + 1` the `i`-th fallback.
+    pub(super) attempt: usize,
+    /// The plan, verified and refined.
+    pub(super) plan: Verified,
+}
+
+impl Planner {
+    /// The planner with `terms` path terms and the same settings otherwise: its
+    /// [`Planner::path`] is the path of a plan whose `path_terms` is `terms`.
+    pub fn with_terms(&self, terms: usize) -> Planner {
+        let mut p = self.clone();
+        p.options.terms = terms;
+        p
+    }
+
+    /// Whether plan `r` is collision-free (to `tol`), feasible on its samples, and estimated to
+    /// coincide with its replay: the order in which plans are preferred, before `U_max`.
+    pub(super) fn class(&self, r: &Verified, tol: f64) -> (bool, bool, bool) {
+        (
+            r.verification.collision_free(tol),
+            r.run.violation <= 1e-6,
+            r.run
+                .equilibrium_deviation
+                .is_some_and(|d| d <= self.options.tolerance),
+        )
+    }
+
+    /// Runs the starts in groups and the fallback path-term counts (see the module's doc),
+    /// verifying each plan on `fine`; `fallbacks` are the planners with the fallback counts.
+    pub(super) fn run_starts(
+        &self,
+        fallbacks: &[Planner],
+        fine: &Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Vec<StartPlan> {
+        let nk = self.options.k_samples;
+        let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
+        let tol = 1e-6 * self.base.model.rod.length;
+        let self_contact = self.has_self_contact();
+        let starts = self.options.starts;
+        let mut runs: Vec<StartPlan> = Vec::new();
+        let attempts = std::iter::once(self).chain(fallbacks);
+        'attempts: for (attempt, pl) in attempts.enumerate() {
+            let path = pl.path();
+            let nv = path.n_vars();
+            let check = |z: &[f64]| {
+                verify_with(
+                    fine,
+                    &path,
+                    z,
+                    self.options.verify_k,
+                    &self.obstacles,
+                    self.base.objective,
+                    self_contact,
+                )
+            };
+            // Start s: the straight-line path plus a perturbation of seed `seed + s`, 0.01 rad
+            // for the first, `start_spread` for the others.
+            let zs: Vec<(usize, Vec<f64>)> = (0..starts)
+                .map(|s| {
+                    let amp = if s == 0 { 1e-2 } else { self.options.spread };
+                    let z0 = noise(self.options.seed.wrapping_add(s as u64), nv)
+                        .into_iter()
+                        .map(|v| amp * v)
+                        .collect();
+                    (attempt * starts + s, z0)
+                })
+                .collect();
+            for group in zs.chunks(self.options.parallel_starts) {
+                if runs
+                    .iter()
+                    .any(|r| self.class(&r.plan, tol) == (true, true, true))
+                {
+                    break 'attempts;
+                }
+                let done = pl.optimise_starts(group, &uniform, &check, observer);
+                runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
+                    index: *index,
+                    attempt,
+                    plan,
+                }));
+            }
+        }
+        runs
+    }
+}
