@@ -36,7 +36,7 @@ use observer::{PathKind, PlanObserver, ShapeRecord};
 use replay::{ReplayOptions, replay};
 use spec::{End, PlanOptions};
 use std::sync::Arc;
-use verify::{fine_model, verify_with};
+use verify::fine_model;
 
 use refine::Verified;
 pub use result::{PlanResult, PlanStatus, StartSummary, Timing};
@@ -284,19 +284,7 @@ impl Planner {
         let path = self.path();
         let nv = path.n_vars();
         let fine = fine_model(model, self.options.verify_s, 4);
-        let self_contact = self.has_self_contact();
-        let check = |z: &[f64]| {
-            verify_with(
-                &fine,
-                &path,
-                z,
-                self.options.verify_k,
-                &self.obstacles,
-                self.base.objective,
-                self_contact,
-            )
-        };
-        let straight = check(&vec![0.0; nv]);
+        let straight = self.verify_on(&fine, &path, &vec![0.0; nv]);
         {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();
@@ -326,14 +314,8 @@ impl Planner {
         }
 
         observer.phase("optimise");
-        let fallbacks: Vec<Planner> = self
-            .options
-            .fallback_terms
-            .iter()
-            .map(|&t| self.with_terms(t))
-            .collect();
         let tol = 1e-6 * model.rod.length;
-        let runs = self.run_starts(&fallbacks, &fine, observer);
+        let runs = self.run_starts(&fine, observer);
         // The plan is the start whose verified path is best: collision-free first, then feasible
         // on the samples, then estimated to coincide with its replay, then the lower true U_max,
         // the lower sampled maximum, the lower index.
@@ -348,11 +330,8 @@ impl Planner {
             })
             .expect("at least one start");
         observer.phase("select");
-        let chosen_planner = match runs[best].attempt {
-            0 => self,
-            a => &fallbacks[a - 1],
-        };
-        let path = chosen_planner.path();
+        let path_terms = runs[best].terms;
+        let path = self.with_terms(path_terms).path();
         let Verified {
             run: chosen,
             verification: ver,
@@ -400,10 +379,7 @@ impl Planner {
                     let v = &r.plan;
                     StartSummary {
                         start: r.index,
-                        path_terms: match r.attempt {
-                            0 => self.options.terms,
-                            a => self.options.fallback_terms[a - 1],
-                        },
+                        path_terms: r.terms,
                         status: v.run.status,
                         sampled_u_max: v.run.sampled_max,
                         u_max: v.verification.u_max,
@@ -416,8 +392,12 @@ impl Planner {
                     }
                 })
                 .collect(),
-            starts_not_run: self.options.starts - runs.iter().filter(|r| r.attempt == 0).count(),
-            path_terms: chosen_planner.options.terms,
+            starts_not_run: self.options.starts
+                - runs
+                    .iter()
+                    .filter(|r| r.index < self.options.starts)
+                    .count(),
+            path_terms,
             chosen_start: runs[best].index,
             path: path.c_vectors(&chosen.z),
             added_samples: added,

@@ -7,17 +7,18 @@ use super::Planner;
 use super::observer::PlanObserver;
 use super::optimise::noise;
 use super::refine::Verified;
-use super::verify::verify_with;
+use super::verify::{Verification, verify_with};
 use crate::model::Model;
+use crate::path::DeformationPath;
 
 /// One start's verified plan and the path-term count it was planned with.
 #[derive(Clone)]
 pub(super) struct StartPlan {
-    /// Index among the starts that ran: the case's own starts first (`0..starts`), then each
-    /// fallback count's (`starts..2·starts`, …).
+    /// Index among the starts: the case's own starts first (`0..starts`), then each fallback
+    /// count's (`starts..2·starts`, …).
     pub(super) index: usize,
-    /// Which path-term count: 0 the case's own, `i + 1` the `i`-th fallback.
-    pub(super) attempt: usize,
+    /// Path terms of its path.
+    pub(super) terms: usize,
     /// The plan, verified and refined.
     pub(super) plan: Verified,
 }
@@ -29,6 +30,24 @@ impl Planner {
         let mut p = self.clone();
         p.options.terms = terms;
         p
+    }
+
+    /// The path `z` of `path` on the verification grid of the quadrature `fine`.
+    pub(super) fn verify_on(
+        &self,
+        fine: &Model,
+        path: &DeformationPath,
+        z: &[f64],
+    ) -> Verification {
+        verify_with(
+            fine,
+            path,
+            z,
+            self.options.verify_k,
+            &self.obstacles,
+            self.base.objective,
+            self.has_self_contact(),
+        )
     }
 
     /// Whether plan `r` is collision-free (to `tol`), feasible on its samples, and estimated to
@@ -44,34 +63,28 @@ impl Planner {
     }
 
     /// Runs the starts in groups and the fallback path-term counts (see the module's doc),
-    /// verifying each plan on `fine`; `fallbacks` are the planners with the fallback counts.
+    /// verifying each plan on `fine`.
     pub(super) fn run_starts(
         &self,
-        fallbacks: &[Planner],
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> Vec<StartPlan> {
+        let fallbacks: Vec<Planner> = self
+            .options
+            .fallback_terms
+            .iter()
+            .map(|&t| self.with_terms(t))
+            .collect();
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let tol = 1e-6 * self.base.model.rod.length;
-        let self_contact = self.has_self_contact();
         let starts = self.options.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
-        let attempts = std::iter::once(self).chain(fallbacks);
+        let attempts = std::iter::once(self).chain(&fallbacks);
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();
-            let check = |z: &[f64]| {
-                verify_with(
-                    fine,
-                    &path,
-                    z,
-                    self.options.verify_k,
-                    &self.obstacles,
-                    self.base.objective,
-                    self_contact,
-                )
-            };
+            let check = |z: &[f64]| self.verify_on(fine, &path, z);
             // Start s: the straight-line path plus a perturbation of seed `seed + s`, 0.01 rad
             // for the first, `start_spread` for the others.
             let zs: Vec<(usize, Vec<f64>)> = (0..starts)
@@ -94,7 +107,7 @@ impl Planner {
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
-                    attempt,
+                    terms: pl.options.terms,
                     plan,
                 }));
             }

@@ -50,15 +50,19 @@ impl Planner {
         // The path before the last round, with its tally: a round that leaves the samples
         // farther from their equilibria is undone.
         let mut before: Option<(Vec<f64>, Tally)> = None;
-        for _ in 0..self.options.track_rounds {
-            let targets = replay::equilibria(
+        // The equilibria the samples' end poses produce, replayed along the samples.
+        let equilibria = |p: &MinimaxProblem, z: &[f64]| {
+            replay::equilibria(
                 &inflated,
                 &self.start,
                 &p.path,
                 z,
                 &p.ks,
                 &self.static_options,
-            );
+            )
+        };
+        for _ in 0..self.options.track_rounds {
+            let targets = equilibria(p, z);
             let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
                 old.iter()
                     .zip(&targets)
@@ -107,14 +111,7 @@ impl Planner {
         // The rounds' budget spent (or none allowed): measure the kept path's samples once
         // more, so that the estimate is there for choosing among starts.
         if estimate.is_none() && !failed {
-            let targets = replay::equilibria(
-                &inflated,
-                &self.start,
-                &p.path,
-                z,
-                &p.ks,
-                &self.static_options,
-            );
+            let targets = equilibria(p, z);
             estimate = Some(p.distance_to(z, &targets));
         }
         (tracking_rounds, kept, estimate)
