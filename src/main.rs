@@ -569,7 +569,7 @@ fn plan_summary(r: &PlanReport) -> String {
             .any(|s| s.path_terms != p.starts[0].path_terms);
         let not_run = if p.starts_not_run > 0 {
             format!(
-                " ({} more not run: this one is estimated to coincide)",
+                " ({} more not run: a plan is estimated to coincide)",
                 p.starts_not_run
             )
         } else {
