@@ -322,8 +322,8 @@ impl Planner {
         let best = (0..runs.len())
             .max_by(|&i, &j| {
                 let (a, b) = (&runs[i].plan, &runs[j].plan);
-                self.class(a, tol)
-                    .cmp(&self.class(b, tol))
+                self.class(a)
+                    .cmp(&self.class(b))
                     .then(b.verification.u_max.total_cmp(&a.verification.u_max))
                     .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
                     .then(j.cmp(&i))

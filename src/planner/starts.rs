@@ -50,11 +50,12 @@ impl Planner {
         )
     }
 
-    /// Whether plan `r` is collision-free (to `tol`), feasible on its samples, and estimated to
+    /// Whether plan `r` is collision-free (to 1e-6 L), feasible on its samples, and estimated to
     /// coincide with its replay: the order in which plans are preferred, before `U_max`.
-    pub(super) fn class(&self, r: &Verified, tol: f64) -> (bool, bool, bool) {
+    pub(super) fn class(&self, r: &Verified) -> (bool, bool, bool) {
         (
-            r.verification.collision_free(tol),
+            r.verification
+                .collision_free(1e-6 * self.base.model.rod.length),
             r.run.violation <= 1e-6,
             r.run
                 .equilibrium_deviation
@@ -77,7 +78,6 @@ impl Planner {
             .collect();
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
-        let tol = 1e-6 * self.base.model.rod.length;
         let starts = self.options.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
         let attempts = std::iter::once(self).chain(&fallbacks);
@@ -100,7 +100,7 @@ impl Planner {
             for group in zs.chunks(self.options.parallel_starts) {
                 if runs
                     .iter()
-                    .any(|r| self.class(&r.plan, tol) == (true, true, true))
+                    .any(|r| self.class(&r.plan) == (true, true, true))
                 {
                     break 'attempts;
                 }
