@@ -21,11 +21,7 @@ pub struct Recovery {
 /// new, finished MCAP written on `out`.
 pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogError> {
     super::writer::check_magic(input)?;
-    let mut w = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
-        .chunk_size(Some(super::writer::CHUNK_BYTES))
-        .profile("")
-        .create(out)?;
+    let mut w = super::writer::write_options().create(out)?;
     let mut channels: HashMap<u16, u16> = HashMap::new();
     let mut schemas: HashMap<u16, u16> = HashMap::new();
     let mut messages = 0;
