@@ -59,6 +59,37 @@ impl Model {
         evaluate_nodes(self, a, shape);
     }
 
+    /// Evaluates `a[j]` into `shapes[j]` for every `j` that `todo` holds, each bit for bit as
+    /// [`Model::evaluate_into`] does; for a rod in the x–z plane, inextensible, the positions'
+    /// running sums (a chain of dependent additions per shape, whose latency would bound the
+    /// time) of four shapes at a time advance side by side.
+    pub fn evaluate_many(
+        &self,
+        a: &[Vec<f64>],
+        shapes: &mut [Shape],
+        todo: impl Fn(usize) -> bool,
+    ) {
+        let mut pending = [0usize; 4];
+        let mut np = 0;
+        for j in 0..shapes.len() {
+            if !todo(j) {
+                continue;
+            }
+            if evaluate_fields(self, &a[j], &mut shapes[j]) {
+                pending[np] = j;
+                np += 1;
+                if np == 4 {
+                    let group = shapes.get_disjoint_mut(pending).expect("distinct samples");
+                    planar_sums_4(self, group);
+                    np = 0;
+                }
+            }
+        }
+        for &j in &pending[..np] {
+            planar_sums_1(self, [&mut shapes[j]]);
+        }
+    }
+
     /// Weights `ωᵢ` such that `|x_b(a) − x_b(a′)| ≤ Σᵢ ωᵢ |aᵢ − a′ᵢ|` at every mesh boundary `b`
     /// (positions in units of L), for a rod whose positions depend on θ alone: in the x–z plane,
     /// inextensible, with a fixed base; `None` for any other rod. A node's tangent
@@ -290,12 +321,64 @@ crate::wide::dispatch! {
 }
 
 crate::wide::dispatch! {
+    fn evaluate_fields(m: &Model, a: &[f64], shape: &mut Shape) -> bool => evaluate_fields_body
+}
+
+crate::wide::dispatch! {
+    fn planar_sums_4(m: &Model, shapes: [&mut Shape; 4]) => planar_sums_body
+}
+
+crate::wide::dispatch! {
+    fn planar_sums_1(m: &Model, shapes: [&mut Shape; 1]) => planar_sums_body
+}
+
+crate::wide::dispatch! {
     fn positions_vjp(m: &Model, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) => Model::positions_vjp_body
 }
 
 /// [`Model::evaluate_into`]'s loops (compiled twice, see [`crate::wide`]).
 #[inline(always)]
 fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
+    if evaluate_fields_body(m, a, shape) {
+        planar_sums_body(m, [shape]);
+    }
+}
+
+/// The positions' running sums of a rod in the x–z plane, inextensible, for `N` shapes whose
+/// fields [`evaluate_fields_body`] has evaluated, side by side: each shape's additions are the
+/// same, in the same order, as one at a time, but the `N` chains of dependent additions
+/// advance together instead of one after the other.
+#[inline(always)]
+fn planar_sums_body<const N: usize>(m: &Model, mut shapes: [&mut Shape; N]) {
+    let g = m.mesh.gauss();
+    let mut x: [[f64; 3]; N] = std::array::from_fn(|s| shapes[s].positions[0]);
+    let mut out: [Vec<[f64; 3]>; N] =
+        std::array::from_fn(|s| std::mem::take(&mut shapes[s].positions));
+    {
+        let st: [&[f64]; N] = std::array::from_fn(|s| &shapes[s].sth[..]);
+        let ct: [&[f64]; N] = std::array::from_fn(|s| &shapes[s].cth[..]);
+        for (p, w) in m.mesh.weights.chunks_exact(g).enumerate() {
+            let nodes = p * g..(p + 1) * g;
+            for (q, &w) in nodes.zip(w) {
+                for s in 0..N {
+                    x[s][0] += w * st[s][q];
+                    x[s][2] += w * ct[s][q];
+                }
+            }
+            for s in 0..N {
+                out[s][p + 1] = x[s];
+            }
+        }
+    }
+    for (shape, pos) in shapes.iter_mut().zip(out) {
+        shape.positions = pos;
+    }
+}
+
+/// [`evaluate_nodes_body`] but the running sums of a rod in the x–z plane, inextensible: for
+/// such a rod it leaves them out (positions sized, the base set) and returns true.
+#[inline(always)]
+fn evaluate_fields_body(m: &Model, a: &[f64], shape: &mut Shape) -> bool {
     let nn = m.nodes();
     let lay = &m.layout;
     let at = lay.field(a, Field::Theta).expect("theta is always present");
@@ -371,21 +454,15 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
     let g = m.mesh.gauss();
     shape.positions.resize(m.mesh.panels() + 1, [0.0; 3]);
     shape.positions[0] = base;
+    if ap.is_none() && ae.is_none() {
+        // In the x–z plane, inextensible: the same sums without the zero terms
+        // ([`planar_sums_body`]).
+        return true;
+    }
     let mut x = base;
     let out = shape.positions[1..].iter_mut();
     let w = m.mesh.weights.chunks_exact(g);
     let (st, ct) = (shape.sth.chunks_exact(g), shape.cth.chunks_exact(g));
-    if ap.is_none() && ae.is_none() {
-        // In the x–z plane, inextensible: the same sums without the zero terms.
-        for (((p, w), st), ct) in out.zip(w).zip(st).zip(ct) {
-            for ((&w, &st), &ct) in w.iter().zip(st).zip(ct) {
-                x[0] += w * st;
-                x[2] += w * ct;
-            }
-            *p = x;
-        }
-        return;
-    }
     let (sp, cp) = (shape.sph.chunks_exact(g), shape.cph.chunks_exact(g));
     let eps = shape.eps.chunks_exact(g);
     for (((((p, w), st), ct), (sp, cp)), eps) in out.zip(w).zip(st).zip(ct).zip(sp.zip(cp)).zip(eps)
@@ -398,6 +475,7 @@ fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
         }
         *p = x;
     }
+    false
 }
 
 /// The rotation matrix `A(φ, θ, ψ) = Rz(φ) Ry(θ) Rz(ψ)` of eq. (1), row-major; its columns are

@@ -56,6 +56,8 @@ pub struct MinimaxProblem {
     senses: Vec<Sense>,
     a: Vec<Vec<f64>>,
     shapes: Vec<Shape>,
+    /// Which samples' shapes the last [`Nlp::values`] left out.
+    kept: Vec<bool>,
     u: Vec<f64>,
     gu: Vec<Vec<f64>>,
     weights: Vec<f64>,
@@ -108,6 +110,7 @@ impl MinimaxProblem {
             senses,
             a: vec![vec![0.0; n]; nk],
             shapes: vec![Shape::default(); nk],
+            kept: vec![false; nk],
             u: vec![0.0; nk],
             gu: vec![vec![0.0; n]; nk],
             weights: vec![0.0; nk],
@@ -273,6 +276,7 @@ impl Nlp for MinimaxProblem {
         // Shapes may be left out only while nothing but the rows reads them (no tracking term,
         // no swept rows, which may have been turned on after skipping was).
         let light = self.targets.is_none() && self.swept.is_none() && self.skip.is_some();
+        // The samples' coefficients, which shapes stay left out, then the other shapes.
         let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
             self.path.shape_at(z, k, &mut self.a[j]);
@@ -281,17 +285,19 @@ impl Nlp for MinimaxProblem {
                 Some(sk) if light => !interior || sk.clear(i, j, &self.a[j]),
                 _ => false,
             };
-            if keep {
-                if let Some(sk) = &mut self.skip {
-                    sk.stale[j] = true;
-                    sk.left_out += 1;
-                }
-            } else {
-                self.model.evaluate_into(&self.a[j], &mut self.shapes[j]);
-                if let Some(sk) = &mut self.skip {
-                    sk.stale[j] = false;
-                }
+            self.kept[j] = keep;
+            if let Some(sk) = &mut self.skip {
+                sk.stale[j] = keep;
+                sk.left_out += keep as usize;
             }
+            i += interior as usize;
+        }
+        let kept = &self.kept;
+        self.model
+            .evaluate_many(&self.a, &mut self.shapes, |j| !kept[j]);
+        for (j, &k) in self.ks.iter().enumerate() {
+            let interior = k > 0.0 && k < 1.0;
+            let keep = self.kept[j];
             self.gu[j].iter_mut().for_each(|g| *g = 0.0);
             let t = self.model.energy(
                 &self.a[j],
@@ -319,7 +325,6 @@ impl Nlp for MinimaxProblem {
                     }
                 }
                 row += per;
-                i += 1;
             }
         }
         if let Some(sw) = &self.swept {
