@@ -138,3 +138,56 @@ fn a_free_twist_angle_is_reported_as_one_neutral_mode() {
     }
     assert_eq!(neutral, [Some(1), Some(0)]);
 }
+
+/// `Model::evaluate_many` (the path optimisation's sampled shapes, four planar position sums
+/// side by side) gives every shape it evaluates bit for bit as `Model::evaluate_into` does,
+/// leaves the others untouched, and handles counts that are not a multiple of four: planar
+/// inextensible and 3D extensible rods, shapes reused from other coefficients.
+#[test]
+fn evaluate_many_matches_evaluate_into_bit_for_bit() {
+    use dlo_planner::kinematics::Shape;
+    let planar = Model::new(
+        rod(),
+        Layout {
+            basis: Basis::new(4),
+            spatial: false,
+            extensible: false,
+            free_base: false,
+        },
+        Discretisation::default(),
+        [0.1, 0.0, -0.2],
+        vec![],
+        &[],
+    );
+    for m in [planar, model([0.3, -0.1, 0.2])] {
+        let n = m.n();
+        let coefs = |seed: f64| -> Vec<Vec<f64>> {
+            (0..7)
+                .map(|j| {
+                    (0..n)
+                        .map(|i| 0.3 * ((seed + 1.7 * j as f64 + 0.9 * i as f64).sin()))
+                        .collect()
+                })
+                .collect()
+        };
+        let (old, a) = (coefs(0.4), coefs(2.1));
+        let todo = |j: usize| j != 2;
+        let mut many: Vec<Shape> = old.iter().map(|a| m.evaluate(a)).collect();
+        m.evaluate_many(&a, &mut many, todo);
+        for (j, sh) in many.iter().enumerate() {
+            let want = m.evaluate(if todo(j) { &a[j] } else { &old[j] });
+            let bits = |s: &Shape| -> Vec<u64> {
+                let fields = [s.th(), s.dth(), s.ph(), s.dph(), s.dps(), s.eps()];
+                let flat = s.positions.iter().flatten();
+                fields
+                    .into_iter()
+                    .flatten()
+                    .chain(flat)
+                    .map(|v| v.to_bits())
+                    .collect()
+            };
+            assert_eq!(bits(sh), bits(&want), "shape {j}");
+            assert_eq!(sh.positions.len(), m.mesh.panels() + 1);
+        }
+    }
+}
