@@ -12,7 +12,7 @@ pub const CHUNK_BYTES: u64 = 64 * 1024;
 
 /// The options of every log written here: zstd chunks of [`CHUNK_BYTES`], compressed on the
 /// thread that writes them. (The mcap crate's default, a pool of compression workers, cost the
-/// planar plan's log 11 % of the run instead of 6 %: its chunks are too small to share.)
+/// planar plan's log 11 % of the run instead of 6–8 %: its chunks are too small to share.)
 pub fn write_options() -> mcap::WriteOptions {
     mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))

@@ -56,8 +56,6 @@ pub struct MinimaxProblem {
     senses: Vec<Sense>,
     a: Vec<Vec<f64>>,
     shapes: Vec<Shape>,
-    /// Which samples' shapes the last [`Nlp::values`] left out.
-    kept: Vec<bool>,
     u: Vec<f64>,
     gu: Vec<Vec<f64>>,
     weights: Vec<f64>,
@@ -110,7 +108,6 @@ impl MinimaxProblem {
             senses,
             a: vec![vec![0.0; n]; nk],
             shapes: vec![Shape::default(); nk],
-            kept: vec![false; nk],
             u: vec![0.0; nk],
             gu: vec![vec![0.0; n]; nk],
             weights: vec![0.0; nk],
@@ -285,19 +282,20 @@ impl Nlp for MinimaxProblem {
                 Some(sk) if light => !interior || sk.clear(i, j, &self.a[j]),
                 _ => false,
             };
-            self.kept[j] = keep;
             if let Some(sk) = &mut self.skip {
                 sk.stale[j] = keep;
                 sk.left_out += keep as usize;
             }
             i += interior as usize;
         }
-        let kept = &self.kept;
+        let left_out =
+            |skip: &Option<ClearSamples>, j: usize| skip.as_ref().is_some_and(|sk| sk.stale[j]);
+        let skip = &self.skip;
         self.model
-            .evaluate_many(&self.a, &mut self.shapes, |j| !kept[j]);
+            .evaluate_many(&self.a, &mut self.shapes, |j| !left_out(skip, j));
         for (j, &k) in self.ks.iter().enumerate() {
             let interior = k > 0.0 && k < 1.0;
-            let keep = self.kept[j];
+            let keep = left_out(&self.skip, j);
             self.gu[j].iter_mut().for_each(|g| *g = 0.0);
             let t = self.model.energy(
                 &self.a[j],
