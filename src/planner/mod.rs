@@ -217,6 +217,11 @@ impl Planner {
         })
     }
 
+    /// Depth below which a verified clearance counts as a collision (1e-6 L).
+    pub(super) fn collision_tolerance(&self) -> f64 {
+        1e-6 * self.base.model.rod.length
+    }
+
     /// Whether the case enforces self-contact.
     pub fn has_self_contact(&self) -> bool {
         self.base
@@ -314,7 +319,7 @@ impl Planner {
         }
 
         observer.phase("optimise");
-        let tol = 1e-6 * model.rod.length;
+        let tol = self.collision_tolerance();
         let runs = self.run_starts(&fine, observer);
         // The plan is the start whose verified path is best: collision-free first, then feasible
         // on the samples, then estimated to coincide with its replay, then the lower true U_max,

@@ -31,7 +31,7 @@ impl Planner {
         check: &(dyn Fn(&[f64]) -> Verification + Sync),
         sink: &mut dyn FnMut(Progress, Vec<f64>),
     ) -> Verified {
-        let tol = 1e-6 * self.base.model.rod.length;
+        let tol = self.collision_tolerance();
         let h = 1.0 / (self.options.verify_k - 1) as f64;
         let gap = self.options.energy_gap;
         let missed_peak = |r: &StartRun, v: &Verification| {

@@ -102,6 +102,9 @@ pub enum Optimiser {
     Newton,
 }
 
+/// The path-term counts accepted (`plan.path_terms` and each of `plan.fallback_path_terms`).
+const PATH_TERMS: (usize, usize) = (1, 12);
+
 fn d_swept() -> bool {
     false
 }
@@ -345,8 +348,9 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
     };
     let start = end("start", &spec.start)?;
     let goal = end("goal", &spec.goal)?;
+    let (terms_lo, terms_hi) = PATH_TERMS;
     for (field, val, lo, hi) in [
-        ("plan.path_terms", spec.path_terms, 1, 12),
+        ("plan.path_terms", spec.path_terms, terms_lo, terms_hi),
         ("plan.k_samples", spec.k_samples, 3, 2001),
         ("plan.verify_k_samples", spec.verify_k_samples, 3, 100_001),
         ("plan.verify_s_samples", spec.verify_s_samples, 2, 10_000),
@@ -360,10 +364,10 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         }
     }
     for (i, &t) in spec.fallback_path_terms.iter().enumerate() {
-        if !(1..=12).contains(&t) {
+        if !(terms_lo..=terms_hi).contains(&t) {
             return Err(v.err(
                 format!("plan.fallback_path_terms[{i}]"),
-                format!("must be in 1..=12, got {t}"),
+                format!("must be in {terms_lo}..={terms_hi}, got {t}"),
             ));
         }
     }

@@ -10,6 +10,7 @@ use super::refine::Verified;
 use super::verify::{Verification, verify_with};
 use crate::model::Model;
 use crate::path::DeformationPath;
+use std::borrow::Cow;
 
 /// One start's verified plan and the path-term count it was planned with.
 #[derive(Clone)]
@@ -50,12 +51,12 @@ impl Planner {
         )
     }
 
-    /// Whether plan `r` is collision-free (to 1e-6 L), feasible on its samples, and estimated to
-    /// coincide with its replay: the order in which plans are preferred, before `U_max`.
+    /// Whether plan `r` is collision-free ([`Planner::collision_tolerance`]), feasible on its
+    /// samples, and estimated to coincide with its replay: the order in which plans are
+    /// preferred, before `U_max`.
     pub(super) fn class(&self, r: &Verified) -> (bool, bool, bool) {
         (
-            r.verification
-                .collision_free(1e-6 * self.base.model.rod.length),
+            r.verification.collision_free(self.collision_tolerance()),
             r.run.violation <= 1e-6,
             r.run
                 .equilibrium_deviation
@@ -70,17 +71,14 @@ impl Planner {
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> Vec<StartPlan> {
-        let fallbacks: Vec<Planner> = self
-            .options
-            .fallback_terms
-            .iter()
-            .map(|&t| self.with_terms(t))
-            .collect();
         let nk = self.options.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let starts = self.options.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
-        let attempts = std::iter::once(self).chain(&fallbacks);
+        // The case's planner, then one per fallback count, made only when it is reached.
+        let fallbacks = self.options.fallback_terms.iter();
+        let attempts = std::iter::once(Cow::Borrowed(self))
+            .chain(fallbacks.map(|&t| Cow::Owned(self.with_terms(t))));
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();
@@ -98,18 +96,19 @@ impl Planner {
                 })
                 .collect();
             for group in zs.chunks(self.options.parallel_starts) {
-                if runs
-                    .iter()
-                    .any(|r| self.class(&r.plan) == (true, true, true))
-                {
-                    break 'attempts;
-                }
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
                     terms: pl.options.terms,
                     plan,
                 }));
+                // Checked before the next group, and before the next fallback planner is made.
+                if runs
+                    .iter()
+                    .any(|r| self.class(&r.plan) == (true, true, true))
+                {
+                    break 'attempts;
+                }
             }
         }
         runs
