@@ -74,9 +74,16 @@ enum Command {
         /// Also write an SVG picture of the plan next to the log.
         #[arg(long)]
         plot: bool,
-        /// Directory of the MCAP log.
+        /// Directory of the MCAP log and the gripper trajectory (`<case name>.trajectory.csv`).
         #[arg(long, default_value = "logs")]
         log_dir: PathBuf,
+        /// Time the gripper trajectory for an end that moves at most this fast (case length
+        /// units per second).
+        #[arg(long, value_name = "SPEED")]
+        max_speed: Option<f64>,
+        /// With `--max-speed`: the end also turns at most this fast (rad/s; default unlimited).
+        #[arg(long, value_name = "RAD_PER_S", requires = "max_speed")]
+        max_angular_speed: Option<f64>,
     },
     /// Disturbance force margin of a grasp (the case's `grasp` section, paper §6): `F_mub` for
     /// each friction coefficient, where and in which direction it is attained.
@@ -137,7 +144,15 @@ fn main() -> ExitCode {
             json,
             plot,
             log_dir,
-        } => run_plan(&case, json, plot, &log_dir),
+            max_speed,
+            max_angular_speed,
+        } => {
+            let speeds = match speed_limits(max_speed, max_angular_speed) {
+                Ok(s) => s,
+                Err(code) => return code,
+            };
+            run_plan(&case, json, plot, &log_dir, speeds)
+        }
         Command::Margin {
             case,
             json,
@@ -412,9 +427,41 @@ struct PlanReport<'a> {
     goal_energy: f64,
     mcap: String,
     log_shapes: u64,
+    trajectory_csv: String,
 }
 
-fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
+/// The validated `--max-speed` and `--max-angular-speed` (the latter infinite when absent).
+fn speed_limits(v: Option<f64>, w: Option<f64>) -> Result<Option<[f64; 2]>, ExitCode> {
+    let Some(v) = v else { return Ok(None) };
+    let w = w.unwrap_or(f64::INFINITY);
+    for (name, x, inf_ok) in [("--max-speed", v, false), ("--max-angular-speed", w, true)] {
+        if !(x > 0.0 && (inf_ok || x.is_finite())) {
+            eprintln!("error: {name}: must be a positive finite number, got {x}");
+            return Err(ExitCode::from(EXIT_BAD_INPUT));
+        }
+    }
+    Ok(Some([v, w]))
+}
+
+/// Writes `text` to `path` through a temporary file moved into place, so that a failed write
+/// leaves no half-written file (and an earlier run's file stays whole until the new one is).
+fn write_atomically(path: &Path, text: &str) -> Result<(), ExitCode> {
+    let tmp = path.with_extension("partial");
+    let written = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
+    written.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        eprintln!("error: {}: cannot write: {e}", path.display());
+        ExitCode::from(EXIT_OUTPUT)
+    })
+}
+
+fn run_plan(
+    path: &Path,
+    json: bool,
+    plot: bool,
+    log_dir: &Path,
+    speeds: Option<[f64; 2]>,
+) -> ExitCode {
     let c = match load(path) {
         Ok(c) => c,
         Err(code) => return code,
@@ -439,6 +486,9 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     };
     let mut result = planner.run(&mut obs);
     result.timing_s.endpoints = t_end;
+    if let Some([v, w]) = speeds {
+        result.trajectory.time_parameterise(v, w);
+    }
     if obs.tty {
         eprintln!();
     }
@@ -454,6 +504,10 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     if let Err(code) = close_log(&log, &log_path) {
         return code;
     }
+    let csv_path = log_dir.join(format!("{}.trajectory.csv", c.name));
+    if let Err(code) = write_atomically(&csv_path, &result.trajectory.to_csv()) {
+        return code;
+    }
     let report = PlanReport {
         case: &c.name,
         result: &result,
@@ -461,6 +515,7 @@ fn run_plan(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         goal_energy: planner.goal.energy.internal(),
         mcap: log_path.display().to_string(),
         log_shapes: obs.log.shapes(),
+        trajectory_csv: csv_path.display().to_string(),
     };
     if json {
         emit(&format!(
@@ -628,6 +683,19 @@ fn plan_summary(r: &PlanReport) -> String {
         };
         let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
     }
+    let t = &p.trajectory;
+    let _ = writeln!(
+        o,
+        "  gripper: path length {:.4e} (straight line {:.4e}), largest step {:.4e}; turns {:.4} rad (largest step {:.4} rad){}; poses {}",
+        t.path_length,
+        t.straight_distance,
+        t.largest_step,
+        t.rotation_angle,
+        t.largest_rotation_step,
+        t.duration_s
+            .map_or(String::new(), |d| format!("; duration {d:.3} s")),
+        r.trajectory_csv
+    );
     let _ = writeln!(
         o,
         "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",

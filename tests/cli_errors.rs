@@ -465,6 +465,38 @@ fn plan_prints_documented_json_and_exit_codes() {
             .ends_with("plan_cable_around_pillar.mcap")
     );
     log_ok("plan_cable_around_pillar");
+    // The gripper trajectory: in the JSON, one pose per replay step, and the same rows in the
+    // CSV next to the log (the header names every column; values round-trip exactly).
+    let steps = v["replay"]["steps"].as_array().unwrap().len();
+    let poses = v["trajectory"]["poses"].as_array().unwrap();
+    assert_eq!(poses.len(), steps);
+    assert_has_keys(
+        &v["trajectory"],
+        "trajectory.",
+        &["frame", "held", "path_length", "straight_distance", "largest_step"],
+    );
+    assert_has_keys(&poses[0], "trajectory.poses[0].", &["k", "position", "quaternion", "rotation"]);
+    let csv_path = v["trajectory_csv"].as_str().unwrap();
+    assert!(csv_path.ends_with("plan_cable_around_pillar.trajectory.csv"));
+    let csv = std::fs::read_to_string(csv_path).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 17);
+    assert_eq!(header[0], "k");
+    assert!(header[1].starts_with("x [case length unit"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), steps);
+    for (row, pose) in rows.iter().zip(poses) {
+        assert_eq!(row[0], pose["k"].as_f64().unwrap());
+        for c in 0..3 {
+            assert_eq!(row[1 + c], pose["position"][c].as_f64().unwrap());
+        }
+        for c in 0..4 {
+            assert_eq!(row[4 + c], pose["quaternion"][c].as_f64().unwrap());
+        }
+    }
 
     // The paper's scheme as written (21 samples, no margin, no mean energy, no tracking, no
     // refinement) tunnels through the block.

@@ -1108,3 +1108,61 @@ fn bar_plan_beats_hand_made_paths_with_its_margin() {
         r.u_max
     );
 }
+
+/// The gripper trajectory is the plan's own end pose: at every replay step, its position equals
+/// the plan's shape's `x(L)` (evaluated independently, by 8-point Gauss quadrature on the last
+/// panel, to 1e-12 L), its rotation matrix equals `A(φ, θ, ψ)` at `s = L` and its quaternion
+/// turns into the same matrix (1e-12); the quaternion never flips hemisphere between steps; the
+/// held end sits at the base, and the path length is the sum of the steps, at least the
+/// straight-line distance.
+#[test]
+fn trajectory_reproduces_the_plans_end_pose() {
+    use dlo_planner::kinematics::rotation;
+    use dlo_planner::planner::trajectory::rotation_of_quaternion;
+    for (p, r) in [paper(), bar()] {
+        let model = &p.base.model;
+        let l = model.rod.length;
+        let path = p.with_terms(r.path_terms).path();
+        let t = &r.trajectory;
+        assert_eq!(t.poses.len(), r.replay.steps.len());
+        let mut a = vec![0.0; path.n()];
+        let mut length = 0.0;
+        for (i, (pose, step)) in t.poses.iter().zip(&r.replay.steps).enumerate() {
+            assert_eq!(pose.k, step.k);
+            path.shape_at(&r.z, pose.k, &mut a);
+            let x = model.position_at(&a, 1.0).map(|v| v * l);
+            for c in 0..3 {
+                assert!(
+                    (pose.position[c] - x[c]).abs() <= 1e-12 * l,
+                    "k = {}: {:?} vs {x:?}",
+                    pose.k,
+                    pose.position
+                );
+            }
+            let [f, th, ps] = model.angles_at(&a, 1.0);
+            let m = rotation(f, th, ps);
+            let mq = rotation_of_quaternion(pose.quaternion);
+            for row in 0..3 {
+                for col in 0..3 {
+                    assert!((pose.rotation[row][col] - m[row][col]).abs() <= 1e-12);
+                    assert!((mq[row][col] - m[row][col]).abs() <= 1e-12);
+                }
+            }
+            if i > 0 {
+                let prev = &t.poses[i - 1];
+                let dot: f64 = prev.quaternion.iter().zip(&pose.quaternion).map(|(x, y)| x * y).sum();
+                assert!(dot >= 0.0, "quaternion flips at k = {}", pose.k);
+                length += (0..3)
+                    .map(|c| (pose.position[c] - prev.position[c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+            }
+        }
+        assert!((t.path_length - length).abs() <= 1e-12 * l);
+        assert!(t.path_length >= t.straight_distance);
+        let base = model.base.map(|v| v * l);
+        for c in 0..3 {
+            assert!((t.held.position[c] - base[c]).abs() <= 1e-12 * l);
+        }
+    }
+}

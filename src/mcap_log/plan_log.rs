@@ -13,10 +13,19 @@
 //! | `/optimiser/progress` | JSON | per outer iteration: smoothed and sampled max, violation, penalty |
 //! | `/optimiser/worst` | `foxglove.SceneUpdate` | the worst sampled shape of each iterate |
 //!
-//! Log time: path parameter `k` ↦ `10 k` seconds, so the timeline scrubs the deformation, and
-//! the optimal and feasible paths sit at the same times. Optimiser iterations are `0.1 s` apart.
+//! Log time: the run's wall-clock start `t0` (so the viewer's timeline says when it ran) plus
+//! `10 k` seconds for path parameter `k`, so the timeline scrubs the deformation, and the
+//! optimal and feasible paths sit at the same times. Optimiser iterations are `0.1 s` apart
+//! from `t0`.
+//!
+//! The plan is drawn translucent and the replay thinner and opaque inside it, so the replay
+//! stays visible where the two coincide. Every JSON schema uses single types only (what
+//! Foxglove's reader accepts): a value that does not exist is left out of the message.
 
-use super::scene::{color, end_pose, gravity_transform, obstacles_update, rod_update, time_of_k};
+use super::scene::{
+    color, end_pose, gravity_transform, obstacles_update, rod_thickness, rod_update, time_of_k,
+    wall_clock_ns,
+};
 use super::writer::{LogError, McapWriter};
 use crate::model::Model;
 use crate::obstacle::Obstacle;
@@ -37,18 +46,20 @@ pub fn lock(w: &SharedWriter) -> std::sync::MutexGuard<'_, McapWriter<BufWriter<
     }
 }
 
-/// The scene every log starts with at time 0: the gravity transform and the obstacles.
+/// The scene every log starts with at its start time `t0`: the gravity transform and the
+/// obstacles.
 fn scene_start(
     w: &mut McapWriter<BufWriter<File>>,
+    t0: u64,
     obstacles: &[Arc<Obstacle>],
     length: f64,
 ) -> Result<(), LogError> {
-    w.proto("/tf", 0, &gravity_transform(0))?;
+    w.proto("/tf", t0, &gravity_transform(t0))?;
     if !obstacles.is_empty() {
         w.proto(
             "/scene/obstacles",
-            0,
-            &obstacles_update(0, obstacles, length),
+            t0,
+            &obstacles_update(t0, obstacles, length),
         )?;
     }
     Ok(())
@@ -58,34 +69,70 @@ fn scene_start(
 pub struct PlanLog {
     writer: SharedWriter,
     obstacles: Vec<Arc<Obstacle>>,
+    t0: u64,
     error: Option<LogError>,
     iterations: u64,
     shapes: u64,
 }
 
-fn metrics_schema() -> serde_json::Value {
+/// The JSON schema of `/metrics/*`: single types only. `clearance` (no obstacles),
+/// `deviation`, `stable` and `violation` (replayed shapes only) are left out of a message where
+/// they have no value.
+pub fn metrics_schema() -> serde_json::Value {
     json!({
         "type": "object",
         "properties": {
-            "k": {"type": "number"},
+            "k": {"type": "number", "description": "path parameter; log time is t0 + 10 k s"},
             "energy": {"type": "object", "properties": {
                 "total": {"type": "number"}, "flexural": {"type": "number"},
                 "torsional": {"type": "number"}, "extensional": {"type": "number"},
                 "gravitational": {"type": "number"}, "work": {"type": "number"}}},
-            "clearance": {"type": ["number", "null"]},
-            "deviation": {"type": ["number", "null"]},
-            "stable": {"type": ["boolean", "null"]},
-            "violation": {"type": ["number", "null"]}
+            "clearance": {"type": "number", "description": "smallest surface gap to an obstacle (absent without obstacles)"},
+            "deviation": {"type": "number", "description": "replay: largest distance to the plan's shape (case units)"},
+            "stable": {"type": "boolean", "description": "replay: second-order stability (absent when not decided)"},
+            "violation": {"type": "number", "description": "replay: constraint violation of the solve (units of L)"}
         }
     })
 }
 
+/// The `/metrics/*` message of one shape (see [`metrics_schema`]).
+fn metrics(r: &ShapeRecord) -> serde_json::Value {
+    let e = r.energy;
+    let mut m = serde_json::Map::new();
+    m.insert("k".into(), json!(r.k));
+    m.insert(
+        "energy".into(),
+        json!({
+            "total": e.potential(), "flexural": e.flexural, "torsional": e.torsional,
+            "extensional": e.extensional, "gravitational": e.gravitational, "work": e.work,
+        }),
+    );
+    let optional = [
+        ("clearance", r.clearance.map(|v| json!(v))),
+        ("deviation", r.deviation.map(|v| json!(v))),
+        ("stable", r.stable.map(|v| json!(v))),
+        ("violation", r.violation.map(|v| json!(v))),
+    ];
+    for (key, value) in optional {
+        if let Some(v) = value {
+            m.insert(key.into(), v);
+        }
+    }
+    serde_json::Value::Object(m)
+}
+
 impl PlanLog {
-    /// A log on `writer` for a problem with `obstacles`.
+    /// A log on `writer` for a problem with `obstacles`, starting at the wall clock's now.
     pub fn new(writer: SharedWriter, obstacles: Vec<Arc<Obstacle>>) -> Self {
+        Self::starting_at(writer, obstacles, wall_clock_ns())
+    }
+
+    /// A log whose time starts at `t0` (ns since the Unix epoch).
+    pub fn starting_at(writer: SharedWriter, obstacles: Vec<Arc<Obstacle>>, t0: u64) -> Self {
         PlanLog {
             writer,
             obstacles,
+            t0,
             error: None,
             iterations: 0,
             shapes: 0,
@@ -141,8 +188,9 @@ impl PlanObserver for PlanLog {
     fn begin(&mut self, model: &Model) {
         let obstacles = self.obstacles.clone();
         let l = model.rod.length;
+        let t0 = self.t0;
         self.with(|w| {
-            scene_start(w, &obstacles, l)?;
+            scene_start(w, t0, &obstacles, l)?;
             w.flush()
         });
     }
@@ -152,38 +200,30 @@ impl PlanObserver for PlanLog {
     }
 
     fn shape(&mut self, model: &Model, r: &ShapeRecord) {
-        let t = time_of_k(r.k);
+        let t = self.t0 + time_of_k(r.k);
         let pts = rod_points(model, r.a);
         let name = topic(r.kind);
-        let c = match r.kind {
-            PathKind::Endpoint => color(0.3, 0.3, 0.3, 1.0),
-            PathKind::Straight => color(0.6, 0.6, 0.6, 0.8),
-            PathKind::Iterate => color(0.9, 0.6, 0.1, 1.0),
-            PathKind::Optimal => color(0.1, 0.4, 0.9, 1.0),
-            PathKind::Feasible => color(0.9, 0.2, 0.2, 1.0),
+        let thick = rod_thickness(model.rod.radius, model.rod.length);
+        // Entity id, colour and thickness: the two end shapes are separate entities (both stay
+        // on screen); the plan is a translucent tube with the replay thinner and opaque inside.
+        let (id, c, thickness) = match r.kind {
+            PathKind::Endpoint if r.k < 0.5 => ("start", color(0.15, 0.65, 0.25, 1.0), thick),
+            PathKind::Endpoint => ("goal", color(0.55, 0.2, 0.7, 1.0), thick),
+            PathKind::Straight => ("straight", color(0.6, 0.6, 0.6, 0.6), thick),
+            PathKind::Iterate => ("iterate", color(0.9, 0.6, 0.1, 1.0), thick),
+            PathKind::Optimal => ("optimal", color(0.1, 0.4, 0.9, 0.45), 1.6 * thick),
+            PathKind::Feasible => ("feasible", color(0.9, 0.2, 0.2, 1.0), 0.6 * thick),
         };
-        let radius = model.rod.radius;
         let angles = model.angles_at(r.a, 1.0);
         let end = *pts.last().expect("at least two boundaries");
-        let e = r.energy;
-        let metrics = json!({
-            "k": r.k,
-            "energy": {
-                "total": e.potential(), "flexural": e.flexural, "torsional": e.torsional,
-                "extensional": e.extensional, "gravitational": e.gravitational, "work": e.work,
-            },
-            "clearance": r.clearance,
-            "deviation": r.deviation,
-            "stable": r.stable,
-            "violation": r.violation,
-        });
+        let metrics = metrics(r);
         let reactions =
             (!r.reactions.is_empty()).then(|| json!({"k": r.k, "reactions": r.reactions}));
         self.with(|w| {
             w.proto(
                 &format!("/rod/{name}"),
                 t,
-                &rod_update(t, "rod", &pts, radius, c),
+                &rod_update(t, id, &pts, thickness, c),
             )?;
             if matches!(r.kind, PathKind::Optimal | PathKind::Feasible) {
                 w.proto(&format!("/end_pose/{name}"), t, &end_pose(t, end, angles))?;
@@ -211,9 +251,9 @@ impl PlanObserver for PlanLog {
 
     fn progress(&mut self, model: &Model, p: &Progress, worst: &[f64]) {
         self.iterations += 1;
-        let t = self.iterations * 100_000_000;
+        let t = self.t0 + self.iterations * 100_000_000;
         let pts = rod_points(model, worst);
-        let radius = model.rod.radius;
+        let thickness = rod_thickness(model.rod.radius, model.rod.length);
         let msg = json!({
             "start": p.start, "stage": p.stage, "outer": p.outer,
             "smoothed_max": p.smoothed_max, "sampled_max": p.sampled_max,
@@ -230,13 +270,14 @@ impl PlanObserver for PlanLog {
             w.proto(
                 "/optimiser/worst",
                 t,
-                &rod_update(t, "worst", &pts, radius, color(0.9, 0.6, 0.1, 1.0)),
+                &rod_update(t, "worst", &pts, thickness, color(0.9, 0.6, 0.1, 1.0)),
             )
         });
     }
 }
 
-/// Logs one static solve (`dlo shape`) at time 0: obstacles, transform, rod, metrics.
+/// Logs one static solve (`dlo shape`) at the wall clock's now: obstacles, transform, rod,
+/// metrics.
 pub fn log_static(
     writer: &SharedWriter,
     model: &Model,
@@ -245,24 +286,26 @@ pub fn log_static(
     metrics: &serde_json::Value,
 ) -> Result<(), LogError> {
     let mut w = lock(writer);
+    let t0 = wall_clock_ns();
     let pts = rod_points(model, a);
     let end = *pts.last().expect("at least two boundaries");
-    scene_start(&mut w, obstacles, model.rod.length)?;
+    let thickness = rod_thickness(model.rod.radius, model.rod.length);
+    scene_start(&mut w, t0, obstacles, model.rod.length)?;
     w.proto(
         "/rod/shape",
-        0,
-        &rod_update(0, "rod", &pts, model.rod.radius, color(0.1, 0.4, 0.9, 1.0)),
+        t0,
+        &rod_update(t0, "shape", &pts, thickness, color(0.1, 0.4, 0.9, 1.0)),
     )?;
     w.proto(
         "/end_pose/shape",
-        0,
-        &end_pose(0, end, model.angles_at(a, 1.0)),
+        t0,
+        &end_pose(t0, end, model.angles_at(a, 1.0)),
     )?;
     w.json(
         "/metrics/shape",
         "dlo.ShapeReport",
         &json!({"type": "object"}),
-        0,
+        t0,
         metrics,
     )?;
     Ok(())
@@ -277,17 +320,19 @@ pub fn log_margin(
     margin: &crate::grasp::Margin,
 ) -> Result<(), LogError> {
     let mut w = lock(writer);
-    scene_start(&mut w, obstacles, model.rod.length)?;
+    let t0 = wall_clock_ns();
+    let thickness = rod_thickness(model.rod.radius, model.rod.length);
+    scene_start(&mut w, t0, obstacles, model.rod.length)?;
     for (i, lim) in margin.table.iter().enumerate() {
-        let t = i as u64 * 100_000_000;
+        let t = t0 + i as u64 * 100_000_000;
         w.proto(
             "/grasp/held_shape",
             t,
             &rod_update(
                 t,
-                "rod",
+                "held_shape",
                 &lim.held_shape,
-                model.rod.radius,
+                thickness,
                 color(0.1, 0.4, 0.9, 1.0),
             ),
         )?;

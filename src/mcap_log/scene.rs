@@ -18,9 +18,24 @@ pub const ROD_FRAME: &str = "rod";
 /// Foxglove's fixed frame.
 pub const WORLD_FRAME: &str = "world";
 
-/// Log time (ns) of path parameter `k`: the path spans 10 s of log time.
+/// Log time (ns after the log's start `t0`) of path parameter `k`: the path spans 10 s of log
+/// time.
 pub fn time_of_k(k: f64) -> u64 {
     (k.clamp(0.0, 1.0) * 10.0e9).round() as u64
+}
+
+/// The wall clock in nanoseconds since the Unix epoch: a log's start time `t0`, so that a
+/// viewer's timeline shows when the run happened (0 if the clock is before the epoch).
+pub fn wall_clock_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
+}
+
+/// Line thickness (case units) of a rod of `radius` and `length`: its diameter, but at least
+/// `length / 250`, so that a thin or zero-radius rod stays visible.
+pub fn rod_thickness(radius: f64, length: f64) -> f64 {
+    (2.0 * radius).max(length / 250.0)
 }
 
 /// Foxglove timestamp of a log time.
@@ -52,33 +67,7 @@ fn identity() -> Quaternion {
 
 /// Quaternion of a rotation matrix (rows).
 pub fn quaternion(m: [[f64; 3]; 3]) -> Quaternion {
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    let (x, y, z, w);
-    if tr > 0.0 {
-        let s = (tr + 1.0).sqrt() * 2.0;
-        w = 0.25 * s;
-        x = (m[2][1] - m[1][2]) / s;
-        y = (m[0][2] - m[2][0]) / s;
-        z = (m[1][0] - m[0][1]) / s;
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt() * 2.0;
-        w = (m[2][1] - m[1][2]) / s;
-        x = 0.25 * s;
-        y = (m[0][1] + m[1][0]) / s;
-        z = (m[0][2] + m[2][0]) / s;
-    } else if m[1][1] > m[2][2] {
-        let s = (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt() * 2.0;
-        w = (m[0][2] - m[2][0]) / s;
-        x = (m[0][1] + m[1][0]) / s;
-        y = 0.25 * s;
-        z = (m[1][2] + m[2][1]) / s;
-    } else {
-        let s = (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt() * 2.0;
-        w = (m[1][0] - m[0][1]) / s;
-        x = (m[0][2] + m[2][0]) / s;
-        y = (m[1][2] + m[2][1]) / s;
-        z = 0.25 * s;
-    }
+    let [w, x, y, z] = crate::planner::trajectory::quaternion_of(m);
     Quaternion { x, y, z, w }
 }
 
@@ -141,8 +130,15 @@ pub fn gravity_transform(t: u64) -> FrameTransform {
     }
 }
 
-/// The rod as a line of thickness `2r` through `points` (case units), entity `id`.
-pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], radius: f64, c: Color) -> SceneUpdate {
+/// The rod as a line of `thickness` (case units, see [`rod_thickness`]) through `points` (case
+/// units), entity `id`.
+pub fn rod_update(
+    t: u64,
+    id: &str,
+    points: &[[f64; 3]],
+    thickness: f64,
+    c: Color,
+) -> SceneUpdate {
     SceneUpdate {
         deletions: vec![],
         entities: vec![SceneEntity {
@@ -158,7 +154,7 @@ pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], radius: f64, c: Color) 
                     position: Some(v3([0.0; 3])),
                     orientation: Some(identity()),
                 }),
-                thickness: 2.0 * radius,
+                thickness,
                 scale_invariant: false,
                 points: points
                     .iter()

@@ -16,6 +16,7 @@ pub mod spec;
 mod starts;
 pub mod swept;
 mod tracking;
+pub mod trajectory;
 pub mod verify;
 
 use crate::case::Case;
@@ -361,6 +362,8 @@ impl Planner {
             observer,
         );
         let t_replay = t1.elapsed().as_secs_f64();
+        let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
+        let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
         let status = if !ver.collision_free(tol) {
             PlanStatus::Collision
         } else if chosen.status != AlStatus::Converged {
@@ -409,6 +412,7 @@ impl Planner {
             z: chosen.z.clone(),
             verification: ver,
             replay: rep,
+            trajectory,
             timing_s: Timing {
                 endpoints: 0.0,
                 plan: t_plan,

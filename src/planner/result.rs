@@ -91,6 +91,9 @@ pub struct PlanResult {
     pub z: Vec<f64>,
     /// Feasibility replay.
     pub replay: Replay,
+    /// The controlled end's pose at every replay step (what a robot holding it follows) and
+    /// the held end's pose.
+    pub trajectory: super::trajectory::Trajectory,
     /// `k` samples added where the verification grid found tunnelling or a missed energy peak.
     pub added_samples: Vec<f64>,
     /// Seconds spent planning (optimise + verify) and replaying.
