@@ -896,7 +896,14 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     if tty {
         eprintln!();
     }
-    let logged = dlo_planner::mcap_log::log_margin(&log, &c.problem.model, &c.obstacles, &margin)
+    let fingers = grasp.finger_contacts();
+    let logged = dlo_planner::mcap_log::log_margin(
+        &log,
+        &c.problem.model,
+        &c.obstacles,
+        &fingers,
+        &margin,
+    )
         .map_err(|e| causes(&e))
         .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
     if let Err(e) = logged {
@@ -960,7 +967,13 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     if plot {
         let svg = log_path.with_extension("svg");
         if let Err(e) =
-            dlo_planner::plot::plot_margin(&margin, &format!("{}: F_mub vs mu", c.name), &svg)
+            dlo_planner::plot::plot_margin(
+                &margin,
+                &grasp.initial_points(),
+                &fingers,
+                &format!("{}: disturbance force margin", c.name),
+                &svg,
+            )
         {
             eprintln!("error: {}: {e}", svg.display());
             return ExitCode::from(EXIT_OUTPUT);

@@ -257,6 +257,49 @@ fn plot_writes_an_svg_from_a_log() {
         "{}",
         &svg[..200.min(svg.len())]
     );
+    // The scene: the block (filled triangles of its silhouette), the legend's entries, and the
+    // colour bar along k (50 filled rectangles in the ramp's colours, from its first stop).
+    assert!(svg.contains("<polygon"), "no obstacle drawn");
+    for label in ["obstacle", "plan at k", "replay by the end pose", "start", "goal"] {
+        assert!(svg.contains(label), "legend lacks {label}");
+    }
+    let c = dlo_planner::plot::ramp(0.01);
+    let fill = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+    assert!(svg.contains(&fill), "no colour bar ({fill})");
+    // A planar case has one view; the paper's case has no y extent.
+    assert!(!svg.contains("top view"));
+}
+
+/// `dlo plot` also draws a static shape's log and a grasp log (its held shapes and fingers),
+/// and says what it needs of any other log.
+#[test]
+fn plot_draws_shape_and_grasp_logs() {
+    let dir = log_dir().join("plot-others");
+    let dlo = env!("CARGO_BIN_EXE_dlo");
+    for (cmd, case) in [
+        ("shape", "planning_cases/pinned_buckling_080.json"),
+        ("margin", "planning_cases/grasp_b_pinch.json"),
+    ] {
+        let out = Command::new(dlo)
+            .args([cmd, case, "--log-dir"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let name = Path::new(case).file_stem().unwrap().to_str().unwrap();
+        let log = dir.join(format!("{name}.mcap"));
+        let svg = dir.join(format!("{name}.log.svg"));
+        let out = Command::new(dlo).arg("plot").arg(&log).arg(&svg).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("polyline"));
+        if cmd == "margin" {
+            assert!(text.contains("finger"), "fingers missing");
+            assert!(text.contains("held shapes"));
+        } else {
+            assert!(text.contains("static shape"));
+        }
+    }
 }
 
 /// Ctrl-C (SIGINT) finishes the log before exiting with code 130: the file is indexed.

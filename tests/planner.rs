@@ -1110,11 +1110,13 @@ fn bar_plan_beats_hand_made_paths_with_its_margin() {
 }
 
 /// The gripper trajectory is the plan's own end pose: at every replay step, its position equals
-/// the plan's shape's `x(L)` (evaluated independently, by 8-point Gauss quadrature on the last
-/// panel, to 1e-12 L), its rotation matrix equals `A(φ, θ, ψ)` at `s = L` and its quaternion
-/// turns into the same matrix (1e-12); the quaternion never flips hemisphere between steps; the
-/// held end sits at the base, and the path length is the sum of the steps, at least the
-/// straight-line distance.
+/// the plan's shape's `x(L)` as the replay's end-position rows prescribe it (the model's
+/// quadrature, evaluated afresh from the path at that step's k) to 1e-12 L, and to 1e-10 L the
+/// same point integrated by another quadrature (8-point Gauss on the last panel: the two
+/// quadratures differ by up to 1.0e-12 L on the bar case); its rotation matrix equals
+/// `A(φ, θ, ψ)` at `s = L` and its quaternion turns into the same matrix (1e-12); the quaternion
+/// never flips hemisphere between steps; the held end sits at the base, and the path length is
+/// the sum of the steps, at least the straight-line distance.
 #[test]
 fn trajectory_reproduces_the_plans_end_pose() {
     use dlo_planner::kinematics::rotation;
@@ -1130,7 +1132,8 @@ fn trajectory_reproduces_the_plans_end_pose() {
         for (i, (pose, step)) in t.poses.iter().zip(&r.replay.steps).enumerate() {
             assert_eq!(pose.k, step.k);
             path.shape_at(&r.z, pose.k, &mut a);
-            let x = model.position_at(&a, 1.0).map(|v| v * l);
+            let x = model.evaluate(&a).positions[model.boundary(1.0)].map(|v| v * l);
+            let x8 = model.position_at(&a, 1.0).map(|v| v * l);
             for c in 0..3 {
                 assert!(
                     (pose.position[c] - x[c]).abs() <= 1e-12 * l,
@@ -1138,6 +1141,7 @@ fn trajectory_reproduces_the_plans_end_pose() {
                     pose.k,
                     pose.position
                 );
+                assert!((pose.position[c] - x8[c]).abs() <= 1e-10 * l);
             }
             let [f, th, ps] = model.angles_at(&a, 1.0);
             let m = rotation(f, th, ps);
@@ -1165,4 +1169,105 @@ fn trajectory_reproduces_the_plans_end_pose() {
             assert!((t.held.position[c] - base[c]).abs() <= 1e-12 * l);
         }
     }
+}
+
+/// The bar case's goal, the shipped Euler angles (φ = π, θ = 0.4, ψ = −π − 0.5), spelled three
+/// other ways: as a unit quaternion, as the other Euler branch (0, −0.4, −0.5), and as its
+/// tangent with a twist of −0.5 about it; the paper's case with its start and goal as
+/// quaternions about y and as tangents. Each spelling gives the shipped plan: the same U_max
+/// (1e-9 relative), the same path vectors (1e-6) and the same replay verdict (deviation to
+/// 1e-6 L). Bad orientations name the field.
+#[test]
+fn equivalent_pose_spellings_give_the_same_plan() {
+    use dlo_planner::kinematics::rotation;
+    use dlo_planner::planner::trajectory::quaternion_of;
+    let same = |name: &str, a: &dlo_planner::planner::PlanResult, b: &dlo_planner::planner::PlanResult| {
+        assert_eq!(a.status, b.status, "{name}");
+        assert!((a.u_max - b.u_max).abs() <= 1e-9 * a.u_max, "{name}: {} vs {}", a.u_max, b.u_max);
+        for (ca, cb) in a.path.iter().flatten().zip(b.path.iter().flatten()) {
+            assert!((ca - cb).abs() <= 1e-6, "{name}: path {ca} vs {cb}");
+        }
+        let (da, db) = (a.replay.max_deviation_over_l, b.replay.max_deviation_over_l);
+        assert!((da - db).abs() <= 1e-6, "{name}: {da} vs {db}");
+        assert_eq!(a.replay.coincide, b.replay.coincide, "{name}");
+    };
+    let with_goal = |f: &dyn Fn(&mut serde_json::Value)| {
+        let c = shipped_variant("plan_cable_under_bar.json", |v| {
+            let g = v["plan"]["goal"].as_object_mut().unwrap();
+            for k in ["phi", "theta", "psi"] {
+                g.remove(k);
+            }
+            f(&mut v["plan"]["goal"]);
+        });
+        Planner::from_case(&c).unwrap().run(&mut Silent)
+    };
+    let pi = std::f64::consts::PI;
+    let m = rotation(pi, 0.4, -pi - 0.5);
+    let q = quaternion_of(m);
+    let shipped = &bar().1;
+    same("quaternion", shipped, &with_goal(&|g| g["quaternion"] = serde_json::json!(q)));
+    same(
+        "other branch",
+        shipped,
+        &with_goal(&|g| {
+            g["phi"] = 0.0.into();
+            g["theta"] = (-0.4).into();
+            g["psi"] = (-0.5).into();
+        }),
+    );
+    same(
+        "tangent",
+        shipped,
+        &with_goal(&|g| {
+            g["tangent"] = serde_json::json!([m[0][2], m[1][2], m[2][2]]);
+            g["twist"] = (-0.5).into();
+        }),
+    );
+    // Planar: quaternions about y and tangents in the x–z plane.
+    let paper_as = |f: &dyn Fn(f64) -> serde_json::Value| {
+        let c = shipped_variant("plan_paper_planar.json", |v| {
+            for (end, theta) in [("start", 0.5), ("goal", -0.5)] {
+                v["plan"][end].as_object_mut().unwrap().remove("theta");
+                let extra = f(theta);
+                for (k, val) in extra.as_object().unwrap() {
+                    v["plan"][end][k] = val.clone();
+                }
+            }
+        });
+        Planner::from_case(&c).unwrap().run(&mut Silent)
+    };
+    let shipped = &paper().1;
+    same("planar quaternion", shipped, &paper_as(&|t: f64| {
+        serde_json::json!({"quaternion": [(0.5 * t).cos(), 0.0, (0.5 * t).sin(), 0.0]})
+    }));
+    same("planar tangent", shipped, &paper_as(&|t: f64| {
+        serde_json::json!({"tangent": [t.sin(), 0.0, t.cos()]})
+    }));
+    // Bad orientations: the field is named.
+    for (goal, field, words) in [
+        (serde_json::json!({"quaternion": [1.0, 0.0, 0.1, 0.0]}), "plan.goal.quaternion", "unit quaternion"),
+        (serde_json::json!({"quaternion": [1.0, 0.0, 0.0, 0.0], "theta": 0.1}), "plan.goal", "one orientation"),
+        (serde_json::json!({"twist": 0.3}), "plan.goal.twist", "tangent"),
+        (serde_json::json!({"tangent": [0.0, 0.0, 0.0]}), "plan.goal.tangent", "non-zero"),
+    ] {
+        let c = shipped_variant("plan_cable_under_bar.json", |v| {
+            let g = v["plan"]["goal"].as_object_mut().unwrap();
+            for k in ["phi", "theta", "psi"] {
+                g.remove(k);
+            }
+            for (k, val) in goal.as_object().unwrap() {
+                g.insert(k.clone(), val.clone());
+            }
+        });
+        let e = Planner::from_case(&c).unwrap_err().to_string();
+        assert!(e.contains(field) && e.contains(words), "{e}");
+    }
+    // A planar rod's end turned about x.
+    let c = shipped_variant("plan_paper_planar.json", |v| {
+        v["plan"]["goal"].as_object_mut().unwrap().remove("theta");
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        v["plan"]["goal"]["quaternion"] = serde_json::json!([h, h, 0.0, 0.0]);
+    });
+    let e = Planner::from_case(&c).unwrap_err().to_string();
+    assert!(e.contains("plan.goal") && e.contains("about y only"), "{e}");
 }

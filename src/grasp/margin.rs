@@ -118,6 +118,32 @@ pub struct Margin {
 }
 
 impl Grasp {
+    /// The undisturbed grasp's shape (case units, at the model's mesh boundaries).
+    pub fn initial_points(&self) -> Vec<[f64; 3]> {
+        let model = &self.case.problem.model;
+        let l = model.rod.length;
+        model
+            .evaluate(&self.initial.a)
+            .positions
+            .iter()
+            .map(|p| p.map(|v| v * l))
+            .collect()
+    }
+
+    /// Every finger's contact point on the undisturbed grasp (case units) and the unit direction
+    /// it pushes the rod in (its normal).
+    pub fn finger_contacts(&self) -> Vec<([f64; 3], [f64; 3])> {
+        let points = self.initial_points();
+        self.fingers
+            .iter()
+            .map(|f| {
+                let mut n = [0.0; 3];
+                n[f.normal_component] = f.normal_sign;
+                (points[f.boundary], n)
+            })
+            .collect()
+    }
+
     /// Validates the `grasp` section and solves the undisturbed grasp.
     pub fn from_case(case: &Case) -> Result<Grasp, Error> {
         let path = &case.path;

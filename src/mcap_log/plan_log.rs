@@ -311,18 +311,28 @@ pub fn log_static(
     Ok(())
 }
 
-/// Logs a margin computation: the last shape that held for every point and direction on
-/// `/grasp/held_shape` (0.1 s apart, in table order) with its limits on `/grasp/limits`.
+/// Logs a margin computation: the fingers on `/grasp/fingers` (an arrow per finger, ending at
+/// its contact point on the undisturbed grasp and pointing the way it pushes), the last shape
+/// that held for every point and direction on `/grasp/held_shape` (0.1 s apart, in table
+/// order) with its limits on `/grasp/limits`.
 pub fn log_margin(
     writer: &SharedWriter,
     model: &Model,
     obstacles: &[Arc<Obstacle>],
+    fingers: &[([f64; 3], [f64; 3])],
     margin: &crate::grasp::Margin,
 ) -> Result<(), LogError> {
     let mut w = lock(writer);
     let t0 = wall_clock_ns();
     let thickness = rod_thickness(model.rod.radius, model.rod.length);
     scene_start(&mut w, t0, obstacles, model.rod.length)?;
+    if !fingers.is_empty() {
+        w.proto(
+            "/grasp/fingers",
+            t0,
+            &super::scene::fingers_update(t0, fingers, model.rod.length),
+        )?;
+    }
     for (i, lim) in margin.table.iter().enumerate() {
         let t = t0 + i as u64 * 100_000_000;
         w.proto(

@@ -185,6 +185,42 @@ pub fn end_pose(t: u64, position: [f64; 3], angles: [f64; 3]) -> PoseInFrame {
     }
 }
 
+/// Length of a finger's arrow over the rod's length.
+pub const FINGER_ARROW: f64 = 0.08;
+
+/// Fingers as red arrows (entity `fingers`): each ends at its contact point and points the way
+/// the finger pushes the rod, `FINGER_ARROW · length` long.
+pub fn fingers_update(t: u64, fingers: &[([f64; 3], [f64; 3])], length: f64) -> SceneUpdate {
+    let len = FINGER_ARROW * length;
+    let arrows = fingers
+        .iter()
+        .map(|(p, n)| {
+            // The arrow's +x is the push direction; its tail sits `len` before the contact.
+            let z = frame_with_z(*n);
+            let m = [0, 1, 2].map(|i| [z[i][2], z[i][0], z[i][1]]);
+            let tail = [0, 1, 2].map(|i| p[i] - len * n[i]);
+            foxglove::schemas::ArrowPrimitive {
+                pose: Some(pose_of(tail, m)),
+                shaft_length: 0.7 * len,
+                shaft_diameter: 0.12 * len,
+                head_length: 0.3 * len,
+                head_diameter: 0.3 * len,
+                color: Some(color(0.9, 0.2, 0.2, 1.0)),
+            }
+        })
+        .collect();
+    SceneUpdate {
+        deletions: vec![],
+        entities: vec![SceneEntity {
+            timestamp: Some(stamp(t)),
+            frame_id: ROD_FRAME.into(),
+            id: "fingers".into(),
+            arrows,
+            ..Default::default()
+        }],
+    }
+}
+
 fn pose_of(position: [f64; 3], m: [[f64; 3]; 3]) -> Pose {
     Pose {
         position: Some(v3(position)),

@@ -9,6 +9,7 @@ pub mod endpoints;
 pub mod minimax;
 pub mod observer;
 mod optimise;
+pub mod orientation;
 mod refine;
 pub mod replay;
 pub mod result;
@@ -192,6 +193,35 @@ fn end_shape(
     Ok(sol)
 }
 
+/// The Euler angles of the held end's frame as the case prescribes it: the orientation
+/// constraints at `s = 0` (a prescribed `φ + ψ` counts as `ψ`), zero where nothing is
+/// prescribed (the natural state's frame).
+fn held_frame(case: &Case) -> [f64; 3] {
+    let mut angles = [0.0; 3];
+    for c in &case.file.constraints {
+        if let crate::case::ConstraintSpec::Orientation {
+            s,
+            phi,
+            theta,
+            psi,
+            phi_plus_psi,
+            ..
+        } = c
+            && *s == 0.0
+        {
+            for (i, v) in [*phi, *theta, *psi].into_iter().enumerate() {
+                if let Some(v) = v {
+                    angles[i] = v;
+                }
+            }
+            if let Some(sum) = phi_plus_psi {
+                angles[2] = sum - angles[0];
+            }
+        }
+    }
+    angles
+}
+
 impl Planner {
     /// Validates the case's `plan` section and solves the start and goal shapes.
     pub fn from_case(case: &Case) -> Result<Planner, Error> {
@@ -204,7 +234,18 @@ impl Planner {
         // the previous shape and must stay on its branch of equilibria (unlimited steps let a
         // solve jump to another equilibrium on the mesh case).
         static_options.al.max_step = static_options.al.max_step.min(0.1);
+        // Full orientations take the Euler branch that continues from the held end's frame
+        // (start) and from the start shape's end (goal).
+        let model = &case.problem.model;
+        let planar = !model.layout.spatial;
+        let resolve = |end: &mut End, field: &str, reference: [f64; 3]| {
+            end.resolve(planar, reference)
+                .map_err(|m| Error::invalid(&case.path, format!("plan.{field}"), m))
+        };
+        let mut options = options;
+        resolve(&mut options.start, "start", held_frame(case))?;
         let start = end_shape(case, "start", &options.start, &static_options)?;
+        resolve(&mut options.goal, "goal", model.angles_at(&start.a, 1.0))?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
         Ok(Planner {

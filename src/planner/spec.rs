@@ -183,8 +183,36 @@ pub struct EndSpec {
     pub theta: Option<f64>,
     /// ψ at `s = L` (spatial rods).
     pub psi: Option<f64>,
+    /// `[x, y, z]` of `P(L)`, instead of `x`, `y`, `z` (`y` must be 0 on a planar rod).
+    pub position: Option<[f64; 3]>,
+    /// The end's orientation as a unit quaternion `[w, x, y, z]` (case frame), instead of Euler
+    /// angles.
+    pub quaternion: Option<[f64; 4]>,
+    /// The end's tangent direction (any length), instead of Euler angles; with `twist`.
+    pub tangent: Option<[f64; 3]>,
+    /// With `tangent`: the turn (radians) about the tangent from the twist-free frame (the
+    /// shortest-arc rotation of the natural state's +z onto the tangent). Default 0.
+    pub twist: Option<f64>,
+    /// How a full orientation (all three Euler angles, a quaternion or a tangent) becomes the
+    /// rod's angles: `"nearest"` (default) picks the branch that continues from the held end
+    /// (start) or the start shape (goal), so equivalent spellings give the same plan;
+    /// `"as_written"` keeps Euler angles exactly as written (e.g. to ask for an extra turn of
+    /// twist).
+    #[serde(default)]
+    pub euler_branch: EulerBranch,
     /// Explicit coefficients: the shape itself when no pose is given, else the solve's start.
     pub shape: Option<ShapeSpec>,
+}
+
+/// See [`EndSpec::euler_branch`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EulerBranch {
+    /// The branch continuing from the reference frame.
+    #[default]
+    Nearest,
+    /// Euler angles exactly as written.
+    AsWritten,
 }
 
 impl EndSpec {
@@ -193,7 +221,21 @@ impl EndSpec {
         [self.x, self.y, self.z, self.phi, self.theta, self.psi]
             .iter()
             .any(Option::is_some)
+            || self.position.is_some()
+            || self.quaternion.is_some()
+            || self.tangent.is_some()
     }
+}
+
+/// A full orientation of an end, resolved into Euler angles once its reference frame is known
+/// (see [`super::orientation`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndRotation {
+    /// The rotation (row-major, case frame).
+    pub matrix: [[f64; 3]; 3],
+    /// The `φ` the user wrote, if the rotation came from Euler angles (it breaks the tie
+    /// between mirror routes).
+    pub written_phi: Option<f64>,
 }
 
 /// A validated end: pose rows in dimensionless units plus an optional coefficient vector.
@@ -201,10 +243,41 @@ impl EndSpec {
 pub struct End {
     /// `(component, x/L)` rows.
     pub position: Vec<(usize, f64)>,
-    /// `(field, angle)` rows.
+    /// `(field, angle)` rows (filled from `rotation` when that is given).
     pub angles: Vec<(crate::layout::Field, f64)>,
+    /// A full orientation whose Euler branch is still to be chosen.
+    pub rotation: Option<EndRotation>,
     /// Coefficients (the shape, or the solve's start).
     pub shape: Option<Vec<f64>>,
+}
+
+impl End {
+    /// Whether the end is a pose (to be solved for), not only coefficients.
+    pub fn is_pose(&self) -> bool {
+        !self.position.is_empty() || !self.angles.is_empty() || self.rotation.is_some()
+    }
+
+    /// Fills in the angles of a full orientation, in the branch that continues from
+    /// `reference` (the Euler angles of the frame it continues from; see
+    /// [`super::orientation`]). Errors name the problem (a planar rod's end turned about
+    /// another axis than y).
+    pub fn resolve(&mut self, planar: bool, reference: [f64; 3]) -> Result<(), String> {
+        use crate::layout::Field;
+        let Some(r) = self.rotation.take() else {
+            return Ok(());
+        };
+        if planar {
+            let theta = super::orientation::planar_branch(r.matrix, reference[1]).ok_or(
+                "a planar rod's end turns about y only: the orientation is not a rotation about y",
+            )?;
+            self.angles = vec![(Field::Theta, theta)];
+        } else {
+            let [phi, theta, psi] =
+                super::orientation::euler_branch(r.matrix, reference, r.written_phi);
+            self.angles = vec![(Field::Phi, phi), (Field::Theta, theta), (Field::Psi, psi)];
+        }
+        Ok(())
+    }
 }
 
 /// Validated planner settings.
@@ -261,6 +334,94 @@ pub struct PlanOptions {
     pub swept: bool,
 }
 
+/// The full orientation of an end, if it has one: its quaternion, its tangent and twist, or
+/// (on a 3D rod, unless `euler_branch` is `as_written`) all three of its Euler angles, which
+/// are then taken out of `angles` to be resolved later.
+fn end_rotation(
+    v: &V,
+    name: &str,
+    e: &EndSpec,
+    angles: &mut Vec<(crate::layout::Field, f64)>,
+    spatial: bool,
+) -> Result<Option<EndRotation>, Error> {
+    let f = |x: &str| format!("plan.{name}.{x}");
+    let forms = [
+        ("quaternion", e.quaternion.is_some()),
+        ("tangent", e.tangent.is_some()),
+        ("phi/theta/psi", !angles.is_empty()),
+    ];
+    let given: Vec<&str> = forms.iter().filter(|g| g.1).map(|g| g.0).collect();
+    if given.len() > 1 {
+        return Err(v.err(
+            f(given[1].split('/').next().unwrap_or("quaternion")),
+            format!("give one orientation: {} and {} are both given", given[0], given[1]),
+        ));
+    }
+    if e.twist.is_some() && e.tangent.is_none() {
+        return Err(v.err(f("twist"), "`twist` turns the end about its `tangent`: give `tangent` too"));
+    }
+    if let Some(q) = e.quaternion {
+        for (i, c) in q.iter().enumerate() {
+            v.finite(&format!("plan.{name}.quaternion[{i}]"), *c)?;
+        }
+        let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if (n - 1.0).abs() > 1e-6 {
+            return Err(v.err(
+                f("quaternion"),
+                format!("must be a unit quaternion [w, x, y, z]: its norm is {n}"),
+            ));
+        }
+        return Ok(Some(EndRotation {
+            matrix: super::trajectory::rotation_of_quaternion(q),
+            written_phi: None,
+        }));
+    }
+    if let Some(t) = e.tangent {
+        for (i, c) in t.iter().enumerate() {
+            v.finite(&format!("plan.{name}.tangent[{i}]"), *c)?;
+        }
+        let n = t.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if !(n > 0.0) || !n.is_finite() {
+            return Err(v.err(f("tangent"), "must be a non-zero direction"));
+        }
+        let twist = v.finite(&f("twist"), e.twist.unwrap_or(0.0))?;
+        if !spatial && (t[1] != 0.0 || twist != 0.0) {
+            return Err(v.err(
+                f(if t[1] != 0.0 { "tangent" } else { "twist" }),
+                "a planar rod's tangent lies in the x–z plane (y = 0) and has no twist",
+            ));
+        }
+        return Ok(Some(EndRotation {
+            matrix: super::orientation::tangent_twist(t, twist),
+            written_phi: None,
+        }));
+    }
+    if e.euler_branch == EulerBranch::AsWritten {
+        return Ok(None);
+    }
+    use crate::layout::Field;
+    let get = |fld| angles.iter().find(|(g, _)| *g == fld).map(|x| x.1);
+    let full = if spatial {
+        match (get(Field::Phi), get(Field::Theta), get(Field::Psi)) {
+            (Some(phi), Some(theta), Some(psi)) => Some((
+                crate::kinematics::rotation(phi, theta, psi),
+                Some(phi),
+            )),
+            _ => None,
+        }
+    } else {
+        // A planar θ has one spelling per shape (θ + 2π is another shape: a loop): as written.
+        None
+    };
+    Ok(full.map(|(matrix, written_phi)| {
+        angles.clear();
+        EndRotation {
+            matrix,
+            written_phi,
+        }
+    }))
+}
+
 /// Reads and validates the case's `plan` section.
 pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
     let v = V { path: &case.path };
@@ -281,7 +442,24 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
     let end = |name: &str, e: &EndSpec| -> Result<End, Error> {
         let f = |x: &str| format!("plan.{name}.{x}");
         let mut position = Vec::new();
-        for (k, (nm, val)) in [("x", e.x), ("y", e.y), ("z", e.z)].into_iter().enumerate() {
+        let xyz = [("x", e.x), ("y", e.y), ("z", e.z)];
+        if let Some(p) = e.position {
+            if let Some((nm, _)) = xyz.iter().find(|(_, val)| val.is_some()) {
+                return Err(v.err(f(nm), "give the position as `position` or as x, y, z, not both"));
+            }
+            for (k, val) in p.into_iter().enumerate() {
+                let val = v.finite(&format!("plan.{name}.position[{k}]"), val)?;
+                if layout.components().contains(&k) {
+                    position.push((k, val / l));
+                } else if val != 0.0 {
+                    return Err(v.err(
+                        format!("plan.{name}.position[1]"),
+                        "a planar rod lies in the x–z plane: y must be 0",
+                    ));
+                }
+            }
+        }
+        for (k, (nm, val)) in xyz.into_iter().enumerate() {
             let Some(val) = val else { continue };
             if !layout.components().contains(&k) {
                 return Err(v.err(f(nm), "a planar rod lies in the x–z plane: remove y"));
@@ -300,6 +478,7 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
             }
             angles.push((fld, v.finite(&f(nm), val)?));
         }
+        let rotation = end_rotation(&v, name, e, &mut angles, layout.spatial)?;
         if !position.is_empty() && !layout.extensible {
             let d2: f64 = position.iter().map(|(_, x)| x * x).sum::<f64>();
             let base = model.base;
@@ -334,15 +513,16 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
             )?),
             None => None,
         };
-        if position.is_empty() && angles.is_empty() && shape.is_none() {
+        if position.is_empty() && angles.is_empty() && rotation.is_none() && shape.is_none() {
             return Err(v.err(
                 format!("plan.{name}"),
-                "give the end pose (x, y, z, phi, theta, psi) or `shape` coefficients",
+                "give the end pose (x, y, z or position; phi, theta, psi or quaternion or tangent) or `shape` coefficients",
             ));
         }
         Ok(End {
             position,
             angles,
+            rotation,
             shape,
         })
     };

@@ -1,0 +1,146 @@
+//! End orientations as robots write them — a rotation (from a quaternion, or a tangent and a
+//! twist about it, or a full set of Euler angles) — turned into the ZYZ Euler angles the rod's
+//! fields use, in the branch that continues from a reference frame.
+//!
+//! One rotation has many Euler spellings: `(φ, θ, ψ)`, `(φ + π, −θ, ψ + π)` and every 2π
+//! multiple of each angle. For a rod they are not all the same state: `φ + ψ` adding 2π is one
+//! more turn of twist, `θ` adding 2π one more loop. The branch chosen here is, in order:
+//! 1. the sign of `θ` nearest the reference's `θ` (`θ ≥ 0` when the reference is on the pole
+//!    `θ = 0`): the interpolated path then keeps `θ` off the pole, where the angles degenerate;
+//! 2. `φ + ψ` nearest the reference's (the least extra twist);
+//! 3. `φ` nearest the written `φ` if the user wrote one, else the reference's `φ`; an exact tie
+//!    (the two mirror routes of a symmetric problem) takes the larger `φ`.
+//!
+//! The reference is the held end's frame for the start and the start shape's end for the goal,
+//! so equivalent spellings of a pose give the same angles and the same plan.
+
+use crate::kinematics::rotation;
+use std::f64::consts::{PI, TAU};
+
+/// A rotation matrix (row-major).
+pub type Matrix = [[f64; 3]; 3];
+
+/// The rotation of a twist-free frame turned to `tangent` and then by `twist` (radians) about
+/// it: `A(φ_t, θ_t, twist − φ_t)`, where `(φ_t, θ_t)` are the tangent's spherical angles. At
+/// `twist = 0` it is the shortest-arc rotation from the natural state's `+z` to the tangent.
+pub fn tangent_twist(tangent: [f64; 3], twist: f64) -> Matrix {
+    let n = tangent.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let t = tangent.map(|v| v / n);
+    let theta = t[2].clamp(-1.0, 1.0).acos();
+    let phi = if t[0] == 0.0 && t[1] == 0.0 {
+        0.0
+    } else {
+        t[1].atan2(t[0])
+    };
+    rotation(phi, theta, twist - phi)
+}
+
+/// Euler angles `(φ, θ, ψ)` of `m` with `θ ∈ [0, π]` (at the poles, `φ = 0`).
+fn principal(m: Matrix) -> [f64; 3] {
+    let theta = m[2][2].clamp(-1.0, 1.0).acos();
+    if theta.sin() > 1e-12 {
+        [m[1][2].atan2(m[0][2]), theta, m[2][1].atan2(-m[2][0])]
+    } else if m[2][2] > 0.0 {
+        // θ = 0: A = Rz(φ + ψ).
+        [0.0, theta, m[1][0].atan2(m[0][0])]
+    } else {
+        // θ = π: A = Rz(φ) diag(−1, 1, −1) Rz(ψ) depends on φ − ψ only.
+        [0.0, theta, -(-m[0][1]).atan2(-m[0][0])]
+    }
+}
+
+/// `x + 2πn` nearest `target`.
+fn nearest(x: f64, target: f64) -> f64 {
+    x + TAU * ((target - x) / TAU).round()
+}
+
+/// The Euler angles of `m` in the branch described in the module documentation, continuing
+/// from `reference` (its `(φ, θ, ψ)`); `written_phi` is the `φ` the user wrote, if any.
+pub fn euler_branch(m: Matrix, reference: [f64; 3], written_phi: Option<f64>) -> [f64; 3] {
+    let [f0, t0, p0] = principal(m);
+    let [rf, rt, rp] = reference;
+    // 1. θ's sign.
+    let (f, theta, p) = if t0 > 0.0 && (-t0 - rt).abs() < (t0 - rt).abs() - 1e-12 {
+        (f0 + PI, -t0, p0 + PI)
+    } else {
+        (f0, t0, p0)
+    };
+    // 2. φ + ψ nearest the reference's.
+    let sum = nearest(f + p, rf + rp);
+    // 3. φ nearest the written (or the reference's) φ; an exact tie takes the larger.
+    let target = written_phi.unwrap_or(rf);
+    let lo = nearest(f, target);
+    let hi = if lo < target { lo + TAU } else { lo - TAU };
+    let phi = if ((hi - target).abs() - (lo - target).abs()).abs() <= 1e-9 {
+        lo.max(hi)
+    } else {
+        lo
+    };
+    [phi, theta, sum - phi]
+}
+
+/// The planar angle `θ` of a rotation about `y` (`m = Ry(θ)`), `2πn` from the one nearest
+/// `reference`; `None` when `m` is not a rotation about `y` (to 1e-6).
+pub fn planar_branch(m: Matrix, reference: f64) -> Option<f64> {
+    let about_y = (m[1][1] - 1.0).abs() <= 1e-6
+        && m[0][1].abs() <= 1e-6
+        && m[2][1].abs() <= 1e-6
+        && m[1][0].abs() <= 1e-6
+        && m[1][2].abs() <= 1e-6;
+    about_y.then(|| nearest(m[0][2].atan2(m[2][2]), reference))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn same(a: Matrix, b: Matrix) -> bool {
+        (0..3).all(|i| (0..3).all(|j| (a[i][j] - b[i][j]).abs() < 1e-12))
+    }
+
+    #[test]
+    fn branches_keep_the_rotation() {
+        for (f, t, p) in [(0.3, 1.1, -0.7), (3.0, -0.4, 2.0), (-1.0, 3.1, 0.4), (0.2, 0.0, 0.5)] {
+            let m = rotation(f, t, p);
+            for r in [[0.0, 0.0, 0.0], [3.0, -1.0, 0.0], [-2.0, 2.0, 7.0]] {
+                let [a, b, c] = euler_branch(m, r, None);
+                assert!(same(rotation(a, b, c), m), "{f} {t} {p} from {r:?}");
+            }
+        }
+    }
+
+    /// The bar case's goal in three spellings gives its hand-written angles.
+    #[test]
+    fn equivalent_spellings_give_one_branch() {
+        let start = [0.0, 0.4, 0.5];
+        let written = [PI, 0.4, -PI - 0.5];
+        let m = rotation(written[0], written[1], written[2]);
+        let tangent = [m[0][2], m[1][2], m[2][2]];
+        for (mat, phi) in [
+            (m, Some(PI)),
+            (rotation(0.0, -0.4, -0.5), Some(0.0)),
+            (tangent_twist(tangent, -0.5), None),
+        ] {
+            let got = euler_branch(mat, start, phi);
+            for i in 0..3 {
+                assert!((got[i] - written[i]).abs() < 1e-12, "{got:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn tangent_twist_points_the_tangent() {
+        let m = tangent_twist([1.0, 2.0, -0.5], 0.3);
+        let n = (1.0f64 + 4.0 + 0.25).sqrt();
+        assert!((m[0][2] - 1.0 / n).abs() < 1e-15);
+        assert!((m[1][2] - 2.0 / n).abs() < 1e-15);
+        assert!((m[2][2] + 0.5 / n).abs() < 1e-15);
+    }
+
+    #[test]
+    fn planar_rotation_is_about_y() {
+        let m = rotation(0.0, 0.5, 0.0);
+        assert!((planar_branch(m, 6.0).unwrap() - (0.5 + TAU)).abs() < 1e-12);
+        assert!(planar_branch(rotation(0.3, 0.5, 0.0), 0.0).is_none());
+    }
+}
