@@ -613,3 +613,46 @@ fn unconverged_solve_and_unwritable_log_exit_codes() {
     );
     assert!(err.contains("os error"), "the system's reason: {err}");
 }
+
+/// Several cases at once: each runs in its own process with its own log, the JSON lines name
+/// every file with its exit code and report, and the exit code is the worst case's (here bad
+/// input, 2, over success); a folder runs its case files that have the section the command
+/// needs.
+#[test]
+fn many_cases_run_in_parallel_with_the_worst_exit_code() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-batch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, r#"{"rod": {"length": -1, "flexural_rigidity": 1}}"#).unwrap();
+    let logs = dir.join("logs");
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/planning_cases/plan_paper_planar.json");
+    let (code, out, err) = run(&[
+        "plan",
+        paper,
+        bad.to_str().unwrap(),
+        "--json",
+        "--log-dir",
+        logs.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("bad.json") && err.contains("rod.length"), "{err}");
+    let lines: Vec<serde_json::Value> = out.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 2);
+    assert_eq!(lines[0]["exit_code"], 0);
+    assert_eq!(lines[0]["report"]["status"], "planned");
+    assert!(lines[0]["file"].as_str().unwrap().ends_with("plan_paper_planar.json"));
+    assert_eq!(lines[1]["exit_code"], 2);
+    assert!(lines[1]["report"].is_null());
+    assert!(logs.join("plan_paper_planar.mcap").exists());
+    // A folder: only its case files with a `grasp` section run under `dlo margin`.
+    let (code, out, err) = run(&[
+        "margin",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/planning_cases"),
+        "--log-dir",
+        logs.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("grasp_a_080.json") && out.contains("grasp_b_pinch.json"), "{out}");
+    assert!(out.contains("2 of 2 cases succeeded"), "{out}");
+    assert!(logs.join("grasp_a_080.mcap").exists() && logs.join("grasp_b_pinch.mcap").exists());
+}

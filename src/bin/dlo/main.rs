@@ -4,6 +4,8 @@
 //! 3 the solver did not converge; 4 no collision-free plan; 5 the replay does not coincide with
 //! the plan; 130 interrupted (the log is finished first).
 
+mod batch;
+
 use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
 use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
@@ -46,8 +48,12 @@ struct Cli {
 enum Command {
     /// Solve the static shape of a case (minimum internal energy under its constraints).
     Shape {
-        /// Case file (JSON).
-        case: PathBuf,
+        /// Case files (JSON) or folders of them; several run in parallel, with a summary.
+        #[arg(required = true, value_name = "CASE")]
+        cases: Vec<PathBuf>,
+        /// With several cases: how many run at a time (default: the machine's cores).
+        #[arg(long)]
+        jobs: Option<usize>,
         /// Print a JSON object on stdout instead of the readable summary.
         #[arg(long)]
         json: bool,
@@ -66,8 +72,13 @@ enum Command {
     /// Plan a deformation path (the case's `plan` section), verify it and replay it by the
     /// controlled end; log every shape to `<log-dir>/<case name>.mcap`.
     Plan {
-        /// Case file (JSON) with a `plan` section.
-        case: PathBuf,
+        /// Case files (JSON) with a `plan` section, or folders of case files (those with a
+        /// `plan` section run); several run in parallel, with a summary.
+        #[arg(required = true, value_name = "CASE")]
+        cases: Vec<PathBuf>,
+        /// With several cases: how many run at a time (default: the machine's cores).
+        #[arg(long)]
+        jobs: Option<usize>,
         /// Print a JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -88,8 +99,13 @@ enum Command {
     /// Disturbance force margin of a grasp (the case's `grasp` section, paper §6): `F_mub` for
     /// each friction coefficient, where and in which direction it is attained.
     Margin {
-        /// Case file (JSON) with fingers among its constraints and a `grasp` section.
-        case: PathBuf,
+        /// Case files (JSON) with fingers among their constraints and a `grasp` section, or
+        /// folders of case files (those with a `grasp` section run).
+        #[arg(required = true, value_name = "CASE")]
+        cases: Vec<PathBuf>,
+        /// With several cases: how many run at a time (default: the machine's cores).
+        #[arg(long)]
+        jobs: Option<usize>,
         /// Print a JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -134,13 +150,18 @@ fn main() -> ExitCode {
     };
     match cli.command {
         Command::Shape {
-            case,
+            cases,
+            jobs,
             json,
             log_dir,
-        } => run_shape(&case, json, &log_dir),
+        } => match single("shape", &cases, None, json, jobs, &log_args(&log_dir, false)) {
+            Ok(case) => run_shape(&case, json, &log_dir),
+            Err(code) => code,
+        },
         Command::Energy { case, json } => run_energy(&case, json),
         Command::Plan {
-            case,
+            cases,
+            jobs,
             json,
             plot,
             log_dir,
@@ -151,14 +172,27 @@ fn main() -> ExitCode {
                 Ok(s) => s,
                 Err(code) => return code,
             };
-            run_plan(&case, json, plot, &log_dir, speeds)
+            let mut extra = log_args(&log_dir, plot);
+            for (flag, v) in [("--max-speed", max_speed), ("--max-angular-speed", max_angular_speed)] {
+                if let Some(v) = v {
+                    extra.extend([flag.to_string(), v.to_string()]);
+                }
+            }
+            match single("plan", &cases, Some("plan"), json, jobs, &extra) {
+                Ok(case) => run_plan(&case, json, plot, &log_dir, speeds),
+                Err(code) => code,
+            }
         }
         Command::Margin {
-            case,
+            cases,
+            jobs,
             json,
             plot,
             log_dir,
-        } => run_margin(&case, json, plot, &log_dir),
+        } => match single("margin", &cases, Some("grasp"), json, jobs, &log_args(&log_dir, plot)) {
+            Ok(case) => run_margin(&case, json, plot, &log_dir),
+            Err(code) => code,
+        },
         Command::Recover { broken, fixed } => run_recover(&broken, &fixed),
         Command::Inspect { file, json } => run_inspect(&file, json),
         Command::Plot { file, output } => {
@@ -166,6 +200,38 @@ fn main() -> ExitCode {
             run_plot(&file, &out)
         }
     }
+}
+
+/// The arguments every case of a batch gets: its log folder, and `--plot`.
+fn log_args(log_dir: &Path, plot: bool) -> Vec<String> {
+    let mut a = vec!["--log-dir".to_string(), log_dir.display().to_string()];
+    if plot {
+        a.push("--plot".into());
+    }
+    a
+}
+
+/// The one case file of a single run; several (or a folder) run as a batch instead, whose exit
+/// code comes back as the error.
+fn single(
+    command: &str,
+    cases: &[PathBuf],
+    section: Option<&str>,
+    json: bool,
+    jobs: Option<usize>,
+    extra: &[String],
+) -> Result<PathBuf, ExitCode> {
+    if let [case] = cases
+        && !case.is_dir()
+    {
+        return Ok(case.clone());
+    }
+    let files = batch::expand(cases, section).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(EXIT_BAD_INPUT)
+    })?;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    Err(batch::run(command, &files, extra, json, jobs))
 }
 
 /// The log being written, finished by the Ctrl-C handler.
