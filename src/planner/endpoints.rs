@@ -86,6 +86,46 @@ impl EndPose {
     }
 }
 
+/// A starting shape for the solve of an end whose orientation is fully given: `a0` (the natural
+/// state with its small perturbation) with each angle field's constant and linear terms set so
+/// that the field runs linearly from the held end's angle `held` at `s = 0` to the end's angle
+/// `end` at `s = L` — a rod already bent and twisted towards its target frame, instead of the
+/// straight rod that must find its way to `φ(L) = π` on its own. Unless the held end fixes
+/// `φ(0)` itself (`phi_fixed`), `φ` starts constant at the end's value (under a `φ + ψ` clamp
+/// the bend's direction is free at the base), and `ψ(0)` keeps the held end's `φ + ψ`.
+pub fn seed_towards(
+    model: &Model,
+    a0: &[f64],
+    held: [f64; 3],
+    phi_fixed: bool,
+    end: [f64; 3],
+) -> Vec<f64> {
+    let mut a = a0.to_vec();
+    let basis = &model.layout.basis;
+    if basis.split().is_some() {
+        return a;
+    }
+    let phi0 = if phi_fixed { held[0] } else { end[0] };
+    let held = [phi0, held[1], held[0] + held[2] - phi0];
+    for (i, field) in [Field::Phi, Field::Theta, Field::Psi].into_iter().enumerate() {
+        let Some(off) = model.layout.offset(field) else {
+            continue;
+        };
+        let n = model.layout.field(&a, field).map_or(0, <[f64]>::len);
+        if n < 2 {
+            continue;
+        }
+        // The perturbation's own values at the ends, so that the seed meets both exactly.
+        a[off] = 0.0;
+        a[off + 1] = 0.0;
+        let c = &a[off..off + n];
+        let (p0, p1) = (basis.eval(c, 0.0), basis.eval(c, 1.0));
+        a[off] = held[i] - p0;
+        a[off + 1] = (end[i] - p1) - (held[i] - p0);
+    }
+    a
+}
+
 /// Solves the static shape for `pose` from `a_start`.
 pub fn solve_end(
     base: &StaticProblem,

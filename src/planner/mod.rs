@@ -123,12 +123,16 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Box<dyn Const
     (linear, blocks)
 }
 
+/// The start or goal shape: `end`'s coefficients as given, or the static solve of its pose,
+/// started from its coefficients, else (a 3D end with all three angles) from a shape bent
+/// from the held frame `seed.0` towards its own `seed.1`, else from the case's initial shape.
 fn end_shape(
     case: &Case,
     field: &str,
     end: &End,
     opts: &StaticOptions,
 ) -> Result<StaticSolution, Error> {
+    let seed = end_angles(end).filter(|_| case.problem.model.layout.spatial).map(|e| (held_frame(case), e));
     let base = &case.problem;
     let pose = EndPose {
         position: end.position.clone(),
@@ -170,7 +174,13 @@ fn end_shape(
             a,
         }
     } else {
-        let a0 = end.shape.clone().unwrap_or_else(|| case.initial.clone());
+        let a0 = match (&end.shape, seed) {
+            (Some(a), _) => a.clone(),
+            (None, Some(((held, phi_fixed), target))) => {
+                endpoints::seed_towards(&base.model, &case.initial, held, phi_fixed, target)
+            }
+            (None, None) => case.initial.clone(),
+        };
         solve_static(&mut pose.problem(base), &a0, opts)
     };
     if sol.status != SolveStatus::Converged {
@@ -193,11 +203,19 @@ fn end_shape(
     Ok(sol)
 }
 
+/// All three Euler angles of an end, when its pose gives them.
+fn end_angles(end: &End) -> Option<[f64; 3]> {
+    use crate::layout::Field;
+    let get = |f| end.angles.iter().find(|(g, _)| *g == f).map(|x| x.1);
+    Some([get(Field::Phi)?, get(Field::Theta)?, get(Field::Psi)?])
+}
+
 /// The Euler angles of the held end's frame as the case prescribes it: the orientation
 /// constraints at `s = 0` (a prescribed `φ + ψ` counts as `ψ`), zero where nothing is
-/// prescribed (the natural state's frame).
-fn held_frame(case: &Case) -> [f64; 3] {
+/// prescribed (the natural state's frame); and whether `φ(0)` itself is prescribed.
+fn held_frame(case: &Case) -> ([f64; 3], bool) {
     let mut angles = [0.0; 3];
+    let mut phi_fixed = false;
     for c in &case.file.constraints {
         if let crate::case::ConstraintSpec::Orientation {
             s,
@@ -217,9 +235,10 @@ fn held_frame(case: &Case) -> [f64; 3] {
             if let Some(sum) = phi_plus_psi {
                 angles[2] = sum - angles[0];
             }
+            phi_fixed |= phi.is_some();
         }
     }
-    angles
+    (angles, phi_fixed)
 }
 
 impl Planner {
@@ -243,7 +262,7 @@ impl Planner {
                 .map_err(|m| Error::invalid(&case.path, format!("plan.{field}"), m))
         };
         let mut options = options;
-        resolve(&mut options.start, "start", held_frame(case))?;
+        resolve(&mut options.start, "start", held_frame(case).0)?;
         let start = end_shape(case, "start", &options.start, &static_options)?;
         resolve(&mut options.goal, "goal", model.angles_at(&start.a, 1.0))?;
         let goal = end_shape(case, "goal", &options.goal, &static_options)?;
