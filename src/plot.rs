@@ -75,7 +75,10 @@ fn line_points(up: &SceneUpdate) -> Vec<[f64; 3]> {
 /// Position and rotation matrix (rows) of a pose.
 fn pose_parts(p: &Option<Pose>) -> ([f64; 3], [[f64; 3]; 3]) {
     let Some(p) = p else {
-        return ([0.0; 3], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        return (
+            [0.0; 3],
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        );
     };
     let t = p.position.as_ref().map_or([0.0; 3], |v| [v.x, v.y, v.z]);
     let q = p
@@ -236,7 +239,9 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
     }
     let held_count = shapes.keys().filter(|(w, _)| *w == "held").count();
     for ((which, t), points) in shapes {
-        let (k, u) = energy.get(&(which, t)).map_or((0.0, None), |&(k, u)| (k, Some(u)));
+        let (k, u) = energy
+            .get(&(which, t))
+            .map_or((0.0, None), |&(k, u)| (k, Some(u)));
         let f = Frame {
             k,
             points,
@@ -254,7 +259,10 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
             }
         }
     }
-    if out.optimal.is_empty() && out.feasible.is_empty() && out.shape.is_none() && out.held.is_empty()
+    if out.optimal.is_empty()
+        && out.feasible.is_empty()
+        && out.shape.is_none()
+        && out.held.is_empty()
     {
         return Err(PlotError::Empty);
     }
@@ -276,7 +284,11 @@ pub fn ramp(k: f64) -> RGBColor {
         (1.0, [253.0, 200.0, 37.0]),
     ];
     let k = k.clamp(0.0, 1.0);
-    let i = STOPS.iter().rposition(|s| s.0 <= k).unwrap_or(0).min(STOPS.len() - 2);
+    let i = STOPS
+        .iter()
+        .rposition(|s| s.0 <= k)
+        .unwrap_or(0)
+        .min(STOPS.len() - 2);
     let (a, b) = (STOPS[i], STOPS[i + 1]);
     let t = (k - a.0) / (b.0 - a.0);
     let c = [0, 1, 2].map(|j| (a.1[j] + t * (b.1[j] - a.1[j])).round() as u8);
@@ -357,10 +369,17 @@ fn draw_view(
     }
     let line = |pts: &[[f64; 3]]| pts.iter().map(pr).collect::<Vec<_>>();
     let mut legend_k = false;
-    let shaped = if f.optimal.is_empty() { &f.held } else { &f.optimal };
+    let shaped = if f.optimal.is_empty() {
+        &f.held
+    } else {
+        &f.optimal
+    };
     for fr in snapshots(shaped, 11) {
         let s = chart
-            .draw_series(LineSeries::new(line(&fr.points), ramp(fr.k).stroke_width(4)))
+            .draw_series(LineSeries::new(
+                line(&fr.points),
+                ramp(fr.k).stroke_width(4),
+            ))
             .map_err(draw_err)?;
         if !legend_k {
             legend_k = true;
@@ -405,7 +424,9 @@ fn draw_view(
                 .draw_series(LineSeries::new(line(pts), colour.stroke_width(4)))
                 .map_err(draw_err)?
                 .label(name)
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], colour.stroke_width(4)));
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 14, y)], colour.stroke_width(4))
+                });
         }
     }
     if !f.fingers.is_empty() {
@@ -417,7 +438,10 @@ fn draw_view(
                 .draw_series([TriangleMarker::new(pr(p), 5, FEASIBLE.filled())])
                 .map_err(draw_err)?;
             let s = chart
-                .draw_series(LineSeries::new([pr(&tail), pr(p)], FEASIBLE.stroke_width(3)))
+                .draw_series(LineSeries::new(
+                    [pr(&tail), pr(p)],
+                    FEASIBLE.stroke_width(3),
+                ))
                 .map_err(draw_err)?;
             if i == 0 {
                 s.label("finger (pushes towards the rod)").legend(|(x, y)| {
@@ -570,7 +594,8 @@ pub fn plot(frames: &PlanFrames, title: &str, path: &std::path::Path) -> Result<
     let ramped = plan || !frames.held.is_empty();
     let views: Vec<View> = if spatial { vec![SIDE, TOP] } else { vec![SIDE] };
     let view_w = 480u32;
-    let width = view_w * views.len() as u32 + if ramped { 100 } else { 0 } + if plan { 440 } else { 0 };
+    let width =
+        view_w * views.len() as u32 + if ramped { 100 } else { 0 } + if plan { 440 } else { 0 };
     let root = SVGBackend::new(path, (width, 460)).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let root = root.titled(title, ("sans-serif", 18)).map_err(draw_err)?;

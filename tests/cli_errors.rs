@@ -473,9 +473,19 @@ fn plan_prints_documented_json_and_exit_codes() {
     assert_has_keys(
         &v["trajectory"],
         "trajectory.",
-        &["frame", "held", "path_length", "straight_distance", "largest_step"],
+        &[
+            "frame",
+            "held",
+            "path_length",
+            "straight_distance",
+            "largest_step",
+        ],
     );
-    assert_has_keys(&poses[0], "trajectory.poses[0].", &["k", "position", "quaternion", "rotation"]);
+    assert_has_keys(
+        &poses[0],
+        "trajectory.poses[0].",
+        &["k", "position", "quaternion", "rotation"],
+    );
     let csv_path = v["trajectory_csv"].as_str().unwrap();
     assert!(csv_path.ends_with("plan_cable_around_pillar.trajectory.csv"));
     let csv = std::fs::read_to_string(csv_path).unwrap();
@@ -625,7 +635,10 @@ fn many_cases_run_in_parallel_with_the_worst_exit_code() {
     let bad = dir.join("bad.json");
     std::fs::write(&bad, r#"{"rod": {"length": -1, "flexural_rigidity": 1}}"#).unwrap();
     let logs = dir.join("logs");
-    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/planning_cases/plan_paper_planar.json");
+    let paper = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/plan_paper_planar.json"
+    );
     let (code, out, err) = run(&[
         "plan",
         paper,
@@ -635,12 +648,23 @@ fn many_cases_run_in_parallel_with_the_worst_exit_code() {
         logs.to_str().unwrap(),
     ]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("bad.json") && err.contains("rod.length"), "{err}");
-    let lines: Vec<serde_json::Value> = out.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(
+        err.contains("bad.json") && err.contains("rod.length"),
+        "{err}"
+    );
+    let lines: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
     assert_eq!(lines.len(), 2);
     assert_eq!(lines[0]["exit_code"], 0);
     assert_eq!(lines[0]["report"]["status"], "planned");
-    assert!(lines[0]["file"].as_str().unwrap().ends_with("plan_paper_planar.json"));
+    assert!(
+        lines[0]["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("plan_paper_planar.json")
+    );
     assert_eq!(lines[1]["exit_code"], 2);
     assert!(lines[1]["report"].is_null());
     assert!(logs.join("plan_paper_planar.mcap").exists());
@@ -652,7 +676,10 @@ fn many_cases_run_in_parallel_with_the_worst_exit_code() {
         logs.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("grasp_a_080.json") && out.contains("grasp_b_pinch.json"), "{out}");
+    assert!(
+        out.contains("grasp_a_080.json") && out.contains("grasp_b_pinch.json"),
+        "{out}"
+    );
     assert!(out.contains("2 of 2 cases succeeded"), "{out}");
     assert!(logs.join("grasp_a_080.mcap").exists() && logs.join("grasp_b_pinch.mcap").exists());
 }

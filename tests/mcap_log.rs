@@ -260,7 +260,13 @@ fn plot_writes_an_svg_from_a_log() {
     // The scene: the block (filled triangles of its silhouette), the legend's entries, and the
     // colour bar along k (50 filled rectangles in the ramp's colours, from its first stop).
     assert!(svg.contains("<polygon"), "no obstacle drawn");
-    for label in ["obstacle", "plan at k", "replay by the end pose", "start", "goal"] {
+    for label in [
+        "obstacle",
+        "plan at k",
+        "replay by the end pose",
+        "start",
+        "goal",
+    ] {
         assert!(svg.contains(label), "legend lacks {label}");
     }
     let c = dlo_planner::plot::ramp(0.01);
@@ -285,12 +291,25 @@ fn plot_draws_shape_and_grasp_logs() {
             .arg(&dir)
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let name = Path::new(case).file_stem().unwrap().to_str().unwrap();
         let log = dir.join(format!("{name}.mcap"));
         let svg = dir.join(format!("{name}.log.svg"));
-        let out = Command::new(dlo).arg("plot").arg(&log).arg(&svg).output().unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = Command::new(dlo)
+            .arg("plot")
+            .arg(&log)
+            .arg(&svg)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(text.contains("polyline"));
         if cmd == "margin" {

@@ -1161,7 +1161,12 @@ fn trajectory_reproduces_the_plans_end_pose() {
             }
             if i > 0 {
                 let prev = &t.poses[i - 1];
-                let dot: f64 = prev.quaternion.iter().zip(&pose.quaternion).map(|(x, y)| x * y).sum();
+                let dot: f64 = prev
+                    .quaternion
+                    .iter()
+                    .zip(&pose.quaternion)
+                    .map(|(x, y)| x * y)
+                    .sum();
                 assert!(dot >= 0.0, "quaternion flips at k = {}", pose.k);
                 length += (0..3)
                     .map(|c| (pose.position[c] - prev.position[c]).powi(2))
@@ -1192,17 +1197,21 @@ fn trajectory_reproduces_the_plans_end_pose() {
 fn equivalent_pose_spellings_give_the_same_plan() {
     use dlo_planner::kinematics::rotation;
     use dlo_planner::planner::trajectory::quaternion_of;
-    let same = |name: &str, a: &dlo_planner::planner::PlanResult, b: &dlo_planner::planner::PlanResult| {
-        assert_eq!(a.status, b.status, "{name}");
-        assert_eq!(a.replay.coincide, b.replay.coincide, "{name}");
-        let du = (a.u_max - b.u_max).abs() / a.u_max;
-        assert!(du <= 5e-5, "{name}: U_max {} vs {}", a.u_max, b.u_max);
-        assert_eq!(a.trajectory.poses.len(), b.trajectory.poses.len(), "{name}");
-        for (p, q) in a.trajectory.poses.iter().zip(&b.trajectory.poses) {
-            let d = (0..3).map(|c| (p.position[c] - q.position[c]).powi(2)).sum::<f64>().sqrt();
-            assert!(d <= 2e-3, "{name}: gripper {d} apart at k = {}", p.k);
-        }
-    };
+    let same =
+        |name: &str, a: &dlo_planner::planner::PlanResult, b: &dlo_planner::planner::PlanResult| {
+            assert_eq!(a.status, b.status, "{name}");
+            assert_eq!(a.replay.coincide, b.replay.coincide, "{name}");
+            let du = (a.u_max - b.u_max).abs() / a.u_max;
+            assert!(du <= 5e-5, "{name}: U_max {} vs {}", a.u_max, b.u_max);
+            assert_eq!(a.trajectory.poses.len(), b.trajectory.poses.len(), "{name}");
+            for (p, q) in a.trajectory.poses.iter().zip(&b.trajectory.poses) {
+                let d = (0..3)
+                    .map(|c| (p.position[c] - q.position[c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(d <= 2e-3, "{name}: gripper {d} apart at k = {}", p.k);
+            }
+        };
     let with_goal = |f: &dyn Fn(&mut serde_json::Value)| {
         let c = shipped_variant("plan_cable_under_bar.json", |v| {
             let g = v["plan"]["goal"].as_object_mut().unwrap();
@@ -1217,7 +1226,11 @@ fn equivalent_pose_spellings_give_the_same_plan() {
     let m = rotation(pi, 0.4, -pi - 0.5);
     let q = quaternion_of(m);
     let shipped = &bar().1;
-    same("quaternion", shipped, &with_goal(&|g| g["quaternion"] = serde_json::json!(q)));
+    same(
+        "quaternion",
+        shipped,
+        &with_goal(&|g| g["quaternion"] = serde_json::json!(q)),
+    );
     same(
         "other branch",
         shipped,
@@ -1249,18 +1262,40 @@ fn equivalent_pose_spellings_give_the_same_plan() {
         Planner::from_case(&c).unwrap().run(&mut Silent)
     };
     let shipped = &paper().1;
-    same("planar quaternion", shipped, &paper_as(&|t: f64| {
-        serde_json::json!({"quaternion": [(0.5 * t).cos(), 0.0, (0.5 * t).sin(), 0.0]})
-    }));
-    same("planar tangent", shipped, &paper_as(&|t: f64| {
-        serde_json::json!({"tangent": [t.sin(), 0.0, t.cos()]})
-    }));
+    same(
+        "planar quaternion",
+        shipped,
+        &paper_as(
+            &|t: f64| serde_json::json!({"quaternion": [(0.5 * t).cos(), 0.0, (0.5 * t).sin(), 0.0]}),
+        ),
+    );
+    same(
+        "planar tangent",
+        shipped,
+        &paper_as(&|t: f64| serde_json::json!({"tangent": [t.sin(), 0.0, t.cos()]})),
+    );
     // Bad orientations: the field is named.
     for (goal, field, words) in [
-        (serde_json::json!({"quaternion": [1.0, 0.0, 0.1, 0.0]}), "plan.goal.quaternion", "unit quaternion"),
-        (serde_json::json!({"quaternion": [1.0, 0.0, 0.0, 0.0], "theta": 0.1}), "plan.goal", "one orientation"),
-        (serde_json::json!({"twist": 0.3}), "plan.goal.twist", "tangent"),
-        (serde_json::json!({"tangent": [0.0, 0.0, 0.0]}), "plan.goal.tangent", "non-zero"),
+        (
+            serde_json::json!({"quaternion": [1.0, 0.0, 0.1, 0.0]}),
+            "plan.goal.quaternion",
+            "unit quaternion",
+        ),
+        (
+            serde_json::json!({"quaternion": [1.0, 0.0, 0.0, 0.0], "theta": 0.1}),
+            "plan.goal",
+            "one orientation",
+        ),
+        (
+            serde_json::json!({"twist": 0.3}),
+            "plan.goal.twist",
+            "tangent",
+        ),
+        (
+            serde_json::json!({"tangent": [0.0, 0.0, 0.0]}),
+            "plan.goal.tangent",
+            "non-zero",
+        ),
     ] {
         let c = shipped_variant("plan_cable_under_bar.json", |v| {
             let g = v["plan"]["goal"].as_object_mut().unwrap();

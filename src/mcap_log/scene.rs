@@ -132,13 +132,7 @@ pub fn gravity_transform(t: u64) -> FrameTransform {
 
 /// The rod as a line of `thickness` (case units, see [`rod_thickness`]) through `points` (case
 /// units), entity `id`.
-pub fn rod_update(
-    t: u64,
-    id: &str,
-    points: &[[f64; 3]],
-    thickness: f64,
-    c: Color,
-) -> SceneUpdate {
+pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], thickness: f64, c: Color) -> SceneUpdate {
     SceneUpdate {
         deletions: vec![],
         entities: vec![SceneEntity {

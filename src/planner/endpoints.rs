@@ -107,7 +107,10 @@ pub fn seed_towards(
     }
     let phi0 = if phi_fixed { held[0] } else { end[0] };
     let held = [phi0, held[1], held[0] + held[2] - phi0];
-    for (i, field) in [Field::Phi, Field::Theta, Field::Psi].into_iter().enumerate() {
+    for (i, field) in [Field::Phi, Field::Theta, Field::Psi]
+        .into_iter()
+        .enumerate()
+    {
         let Some(off) = model.layout.offset(field) else {
             continue;
         };

@@ -132,7 +132,9 @@ fn end_shape(
     end: &End,
     opts: &StaticOptions,
 ) -> Result<StaticSolution, Error> {
-    let seed = end_angles(end).filter(|_| case.problem.model.layout.spatial).map(|e| (held_frame(case), e));
+    let seed = end_angles(end)
+        .filter(|_| case.problem.model.layout.spatial)
+        .map(|e| (held_frame(case), e));
     let base = &case.problem;
     let pose = EndPose {
         position: end.position.clone(),

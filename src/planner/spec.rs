@@ -354,11 +354,17 @@ fn end_rotation(
     if given.len() > 1 {
         return Err(v.err(
             f(given[1].split('/').next().unwrap_or("quaternion")),
-            format!("give one orientation: {} and {} are both given", given[0], given[1]),
+            format!(
+                "give one orientation: {} and {} are both given",
+                given[0], given[1]
+            ),
         ));
     }
     if e.twist.is_some() && e.tangent.is_none() {
-        return Err(v.err(f("twist"), "`twist` turns the end about its `tangent`: give `tangent` too"));
+        return Err(v.err(
+            f("twist"),
+            "`twist` turns the end about its `tangent`: give `tangent` too",
+        ));
     }
     if let Some(q) = e.quaternion {
         for (i, c) in q.iter().enumerate() {
@@ -403,10 +409,9 @@ fn end_rotation(
     let get = |fld| angles.iter().find(|(g, _)| *g == fld).map(|x| x.1);
     let full = if spatial {
         match (get(Field::Phi), get(Field::Theta), get(Field::Psi)) {
-            (Some(phi), Some(theta), Some(psi)) => Some((
-                crate::kinematics::rotation(phi, theta, psi),
-                Some(phi),
-            )),
+            (Some(phi), Some(theta), Some(psi)) => {
+                Some((crate::kinematics::rotation(phi, theta, psi), Some(phi)))
+            }
             _ => None,
         }
     } else {
@@ -445,7 +450,10 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         let xyz = [("x", e.x), ("y", e.y), ("z", e.z)];
         if let Some(p) = e.position {
             if let Some((nm, _)) = xyz.iter().find(|(_, val)| val.is_some()) {
-                return Err(v.err(f(nm), "give the position as `position` or as x, y, z, not both"));
+                return Err(v.err(
+                    f(nm),
+                    "give the position as `position` or as x, y, z, not both",
+                ));
             }
             for (k, val) in p.into_iter().enumerate() {
                 let val = v.finite(&format!("plan.{name}.position[{k}]"), val)?;

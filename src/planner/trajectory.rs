@@ -169,7 +169,12 @@ impl Trajectory {
             // Keep the quaternion in the previous one's hemisphere: q and −q are the same
             // rotation, and a controller interpolating between them would turn the long way.
             if let Some(prev) = poses.last() {
-                let d: f64 = prev.quaternion.iter().zip(&p.quaternion).map(|(x, y)| x * y).sum();
+                let d: f64 = prev
+                    .quaternion
+                    .iter()
+                    .zip(&p.quaternion)
+                    .map(|(x, y)| x * y)
+                    .sum();
                 if d < 0.0 {
                     p.quaternion = p.quaternion.map(|v| -v);
                 }
@@ -276,7 +281,12 @@ mod tests {
 
     #[test]
     fn quaternion_and_matrix_round_trip() {
-        for (f, t, s) in [(0.3, 1.1, -0.7), (3.0, 0.01, -2.0), (-1.0, 3.1, 0.4), (0.0, 0.0, 0.0)] {
+        for (f, t, s) in [
+            (0.3, 1.1, -0.7),
+            (3.0, 0.01, -2.0),
+            (-1.0, 3.1, 0.4),
+            (0.0, 0.0, 0.0),
+        ] {
             let m = rotation(f, t, s);
             let q = quaternion_of(m);
             assert!((q.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-14);

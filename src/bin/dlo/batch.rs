@@ -31,7 +31,8 @@ pub fn expand(paths: &[PathBuf], section: Option<&str>) -> Result<Vec<PathBuf>, 
             out.push(p.clone());
             continue;
         }
-        let entries = std::fs::read_dir(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+        let entries =
+            std::fs::read_dir(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
         let mut files: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|f| f.is_file() && f.extension().is_some_and(|x| x == "json"))
@@ -71,7 +72,13 @@ struct Outcome {
 }
 
 /// Runs `dlo <command> CASE --json <extra…>` for every case, `jobs` at a time, and reports.
-pub fn run(command: &str, cases: &[PathBuf], extra: &[String], json: bool, jobs: usize) -> ExitCode {
+pub fn run(
+    command: &str,
+    cases: &[PathBuf],
+    extra: &[String],
+    json: bool,
+    jobs: usize,
+) -> ExitCode {
     let exe = match std::env::current_exe() {
         Ok(e) => e,
         Err(e) => {
@@ -98,7 +105,10 @@ pub fn run(command: &str, cases: &[PathBuf], extra: &[String], json: bool, jobs:
                             eprintln!("{}: {line}", case.display());
                         }
                     }
-                    results.lock().unwrap_or_else(|p| p.into_inner()).push((i, o));
+                    results
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push((i, o));
                 }
             });
         }
@@ -108,7 +118,11 @@ pub fn run(command: &str, cases: &[PathBuf], extra: &[String], json: bool, jobs:
     }
     let outcomes: Vec<Outcome> = outcomes.into_iter().flatten().collect();
     let code = outcomes.iter().fold(0, |acc, o| worst(acc, o.code));
-    let text = if json { json_lines(&outcomes) } else { table(command, &outcomes) };
+    let text = if json {
+        json_lines(&outcomes)
+    } else {
+        table(command, &outcomes)
+    };
     super::emit(&text);
     ExitCode::from(code)
 }
@@ -127,7 +141,10 @@ fn run_one(exe: &Path, command: &str, case: &Path, extra: &[String]) -> Outcome 
         Ok(o) => Outcome {
             case: case.to_path_buf(),
             // A child killed by a signal (no code) counts as interrupted.
-            code: o.status.code().map_or(130, |c| u8::try_from(c).unwrap_or(1)),
+            code: o
+                .status
+                .code()
+                .map_or(130, |c| u8::try_from(c).unwrap_or(1)),
             json: serde_json::from_slice(&o.stdout).ok(),
             stderr: String::from_utf8_lossy(&o.stderr).trim_end().to_string(),
             seconds,
@@ -183,7 +200,10 @@ fn table(command: &str, outcomes: &[Outcome]) -> String {
         let status = match v {
             // A margin report has no status: it is a lower bound where the search was capped.
             Some(v) if command == "margin" => {
-                if v["capped"].as_array().is_some_and(|c| c.iter().any(|x| x == true)) {
+                if v["capped"]
+                    .as_array()
+                    .is_some_and(|c| c.iter().any(|x| x == true))
+                {
                     "capped"
                 } else {
                     "computed"
@@ -212,7 +232,10 @@ fn table(command: &str, outcomes: &[Outcome]) -> String {
             ),
             (_, Some(v)) => format!(
                 "{:.6e}",
-                v["f_mub"].get(0).and_then(|f| f.as_f64()).unwrap_or(f64::NAN)
+                v["f_mub"]
+                    .get(0)
+                    .and_then(|f| f.as_f64())
+                    .unwrap_or(f64::NAN)
             ),
         };
         let _ = writeln!(

@@ -154,7 +154,14 @@ fn main() -> ExitCode {
             jobs,
             json,
             log_dir,
-        } => match single("shape", &cases, None, json, jobs, &log_args(&log_dir, false)) {
+        } => match single(
+            "shape",
+            &cases,
+            None,
+            json,
+            jobs,
+            &log_args(&log_dir, false),
+        ) {
             Ok(case) => run_shape(&case, json, &log_dir),
             Err(code) => code,
         },
@@ -173,7 +180,10 @@ fn main() -> ExitCode {
                 Err(code) => return code,
             };
             let mut extra = log_args(&log_dir, plot);
-            for (flag, v) in [("--max-speed", max_speed), ("--max-angular-speed", max_angular_speed)] {
+            for (flag, v) in [
+                ("--max-speed", max_speed),
+                ("--max-angular-speed", max_angular_speed),
+            ] {
                 if let Some(v) = v {
                     extra.extend([flag.to_string(), v.to_string()]);
                 }
@@ -189,7 +199,14 @@ fn main() -> ExitCode {
             json,
             plot,
             log_dir,
-        } => match single("margin", &cases, Some("grasp"), json, jobs, &log_args(&log_dir, plot)) {
+        } => match single(
+            "margin",
+            &cases,
+            Some("grasp"),
+            json,
+            jobs,
+            &log_args(&log_dir, plot),
+        ) {
             Ok(case) => run_margin(&case, json, plot, &log_dir),
             Err(code) => code,
         },
@@ -963,15 +980,10 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         eprintln!();
     }
     let fingers = grasp.finger_contacts();
-    let logged = dlo_planner::mcap_log::log_margin(
-        &log,
-        &c.problem.model,
-        &c.obstacles,
-        &fingers,
-        &margin,
-    )
-        .map_err(|e| causes(&e))
-        .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
+    let logged =
+        dlo_planner::mcap_log::log_margin(&log, &c.problem.model, &c.obstacles, &fingers, &margin)
+            .map_err(|e| causes(&e))
+            .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
     if let Err(e) = logged {
         eprintln!("error: {}: cannot write the log: {e}", log_path.display());
         return ExitCode::from(EXIT_OUTPUT);
@@ -1032,15 +1044,13 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     }
     if plot {
         let svg = log_path.with_extension("svg");
-        if let Err(e) =
-            dlo_planner::plot::plot_margin(
-                &margin,
-                &grasp.initial_points(),
-                &fingers,
-                &format!("{}: disturbance force margin", c.name),
-                &svg,
-            )
-        {
+        if let Err(e) = dlo_planner::plot::plot_margin(
+            &margin,
+            &grasp.initial_points(),
+            &fingers,
+            &format!("{}: disturbance force margin", c.name),
+            &svg,
+        ) {
             eprintln!("error: {}: {e}", svg.display());
             return ExitCode::from(EXIT_OUTPUT);
         }
