@@ -375,9 +375,56 @@ pub struct Case {
     pub file: CaseFile,
 }
 
+/// The largest case file read (bytes): far above any real case, small enough that a path to
+/// `/dev/zero` or a huge file fails at once instead of filling the memory.
+pub const MAX_CASE_BYTES: u64 = 64 << 20;
+/// The largest OBJ mesh read (bytes).
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
+
+/// Reads at most `cap` bytes of `path`; a longer file (or an endless one such as `/dev/zero`)
+/// is an error that says so.
+pub fn read_capped(path: &Path, cap: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_char_device() || t.is_block_device() {
+            return Err(std::io::Error::other("a device, not a file"));
+        }
+    }
+    if meta.is_dir() {
+        return Err(std::io::Error::other("a folder, not a file"));
+    }
+    if meta.is_file() && meta.len() > cap {
+        return Err(std::io::Error::other(format!(
+            "{} MiB, larger than the {} MiB this tool reads",
+            meta.len() >> 20,
+            cap >> 20
+        )));
+    }
+    let mut bytes = Vec::new();
+    file.take(cap + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > cap {
+        return Err(std::io::Error::other(format!(
+            "larger than the {} MiB this tool reads",
+            cap >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
+/// [`read_capped`] as UTF-8 text.
+pub fn read_text_capped(path: &Path, cap: u64) -> std::io::Result<String> {
+    String::from_utf8(read_capped(path, cap)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
+}
+
 /// Reads and validates a case file.
 pub fn load(path: &Path) -> Result<Case, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+    let text = read_text_capped(path, MAX_CASE_BYTES).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         source: e,
     })?;
@@ -953,7 +1000,7 @@ fn build_shape(
         ShapeKind::TriangleMesh { obj, scale } => {
             let sc = v.positive(&format!("{field}.scale"), *scale)?;
             let full = case_path.parent().unwrap_or(Path::new(".")).join(obj);
-            let text = std::fs::read_to_string(&full).map_err(|e| {
+            let text = read_text_capped(&full, MAX_MESH_BYTES).map_err(|e| {
                 v.err(
                     format!("{field}.obj"),
                     format!("cannot read {}: {e}", full.display()),

@@ -683,3 +683,118 @@ fn many_cases_run_in_parallel_with_the_worst_exit_code() {
     assert!(out.contains("2 of 2 cases succeeded"), "{out}");
     assert!(logs.join("grasp_a_080.mcap").exists() && logs.join("grasp_b_pinch.mcap").exists());
 }
+
+/// Hostile inputs and outputs get a clean error naming the file or field, a documented exit
+/// code and no panic; an input is never written over: empty grasp points and friction
+/// coefficients, an absurd search cap, a device for a case file, a picture or a recovered log
+/// aimed at its own input; a direction with huge components is normalised, not rejected;
+/// stdout on a full device is exit 1, a closed pipe ends the output quietly.
+#[test]
+fn hostile_inputs_and_outputs_fail_cleanly() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let logs = dir.join("logs");
+    let logs_s = logs.to_str().unwrap();
+    let grasp = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/grasp_a_080.json"
+    ))
+    .unwrap();
+    let with_grasp = |name: &str, section: serde_json::Value| {
+        let mut v: serde_json::Value = serde_json::from_str(&grasp).unwrap();
+        v["grasp"] = section;
+        v["name"] = name.into();
+        let p = dir.join(format!("{name}.json"));
+        std::fs::write(&p, v.to_string()).unwrap();
+        p
+    };
+    for (name, section, field) in [
+        (
+            "no_points",
+            serde_json::json!({"points": []}),
+            "grasp.points",
+        ),
+        ("no_mu", serde_json::json!({"mu": []}), "grasp.mu"),
+        (
+            "huge_cap",
+            serde_json::json!({"f_max": 1e300}),
+            "grasp.f_max",
+        ),
+    ] {
+        let p = with_grasp(name, section);
+        let (code, out, err) = run(&["margin", p.to_str().unwrap(), "--log-dir", logs_s]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(field) && !err.contains("panicked"),
+            "{name}: {err}"
+        );
+        assert!(out.is_empty());
+    }
+    let p = with_grasp(
+        "huge_direction",
+        serde_json::json!({"points": [50.0], "mu": [0.5], "directions": [[1e200, 1e200]]}),
+    );
+    let (code, out, err) = run(&["margin", p.to_str().unwrap(), "--json", "--log-dir", logs_s]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let d = v["direction"][0].as_array().unwrap();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    // [n_z, n_x] = [1e200, 1e200] is the unit vector (x, y, z) = (1, 0, 1)/√2.
+    assert!(
+        (d[0].as_f64().unwrap() - h).abs() < 1e-15 && (d[2].as_f64().unwrap() - h).abs() < 1e-15
+    );
+
+    #[cfg(unix)]
+    {
+        let (code, _, err) = run(&["shape", "/dev/zero"]);
+        assert_eq!(code, 2);
+        assert!(err.contains("/dev/zero") && err.contains("device"), "{err}");
+        // stdout on a full device.
+        let case = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/planning_cases/pinned_buckling_080.json"
+        );
+        let full = std::fs::File::create("/dev/full").unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+            .args(["shape", case, "--log-dir", logs_s])
+            .stdout(full)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("stdout"));
+        // A closed pipe: the reader goes away before the output is written.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_dlo"))
+            .args(["shape", case, "--log-dir", logs_s])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(0));
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    }
+    // Readers never write over their input.
+    let log = logs.join("pinned_buckling_080.mcap");
+    let bytes = std::fs::read(&log).unwrap();
+    let (code, _, err) = run(&["plot", log.to_str().unwrap(), log.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("overwrite"));
+    assert_eq!(std::fs::read(&log).unwrap(), bytes);
+    let partial = dir.join("x.mcap.partial");
+    std::fs::write(&partial, &bytes).unwrap();
+    let fixed = dir.join("x.mcap");
+    let (code, _, err) = run(&[
+        "recover",
+        partial.to_str().unwrap(),
+        fixed.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        std::fs::read(&partial).unwrap(),
+        bytes,
+        "the input was changed"
+    );
+    let (code, _, err) = run(&["recover", fixed.to_str().unwrap(), fixed.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+}

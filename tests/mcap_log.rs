@@ -175,14 +175,20 @@ fn unfinished_log_is_recovered() {
 fn plan_until_first_chunks(sub: &str) -> (std::process::Child, PathBuf) {
     let dir = log_dir().join(sub);
     let _ = std::fs::remove_dir_all(&dir);
+    plan_into_until_first_chunks(&dir)
+}
+
+/// Starts `dlo plan` on the paper's case with its log in `dir`, and returns once the log it is
+/// writing (under its temporary name, `<name>.mcap.<pid>.partial`) holds a few chunks.
+fn plan_into_until_first_chunks(dir: &Path) -> (std::process::Child, PathBuf) {
     let child = Command::new(env!("CARGO_BIN_EXE_dlo"))
         .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
-        .arg(&dir)
+        .arg(dir)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    let log = dir.join("plan_paper_planar.mcap");
+    let log = dir.join(format!("plan_paper_planar.mcap.{}.partial", child.id()));
     let t0 = std::time::Instant::now();
     while std::fs::metadata(&log).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
         std::thread::sleep(std::time::Duration::from_millis(20));
@@ -321,26 +327,32 @@ fn plot_draws_shape_and_grasp_logs() {
     }
 }
 
-/// Ctrl-C (SIGINT) finishes the log before exiting with code 130: the file is indexed.
+/// Ctrl-C (SIGINT) and SIGTERM finish the log before exiting with code 130: the file is
+/// indexed and in place.
 #[test]
 #[cfg(unix)]
 fn interrupted_plan_leaves_a_finished_log() {
-    let (child, log) = plan_until_first_chunks("interrupted");
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let out = child.wait_with_output().unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let bytes = std::fs::read(&log).unwrap();
-    let counts = check_log(&bytes);
-    assert!(counts["/rod/straight"] == 41, "{counts:?}");
+    // Ctrl-C (SIGINT) and SIGTERM alike.
+    for signal in ["INT", "TERM"] {
+        let (child, partial) = plan_until_first_chunks(&format!("interrupted-{signal}"));
+        let status = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(130),
+            "{signal}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // Finished and moved into place.
+        assert!(!partial.exists(), "{signal}: the temporary log is left");
+        let bytes = std::fs::read(partial.with_file_name("plan_paper_planar.mcap")).unwrap();
+        let counts = check_log(&bytes);
+        assert!(counts["/rod/straight"] == 41, "{signal}: {counts:?}");
+    }
 }
 
 /// `dlo margin --json --plot` prints the documented keys, draws the curve and logs every held
@@ -383,4 +395,33 @@ fn margin_command_reports_plots_and_logs() {
     let counts = check_log(&std::fs::read(dir.join("grasp_b_pinch.mcap")).unwrap());
     assert_eq!(counts["/grasp/held_shape"], 81);
     assert_eq!(counts["/grasp/limits"], 81);
+}
+
+/// A rerun killed hard leaves the previous run's finished log as it was (the new log is written
+/// under a temporary name and moved into place only when finished), and its own finished chunks
+/// in that temporary file.
+#[test]
+#[cfg(unix)]
+fn killed_rerun_keeps_the_finished_log() {
+    let dir = log_dir().join("rerun");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let log = dir.join("plan_paper_planar.mcap");
+    let before = std::fs::read(&log).unwrap();
+    check_log(&before);
+    let (mut child, partial) = plan_into_until_first_chunks(&dir);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(
+        std::fs::read(&log).unwrap(),
+        before,
+        "the finished log changed"
+    );
+    assert!(std::fs::metadata(&partial).unwrap().len() > 0);
+    let _ = std::fs::remove_file(&partial);
 }

@@ -33,11 +33,14 @@ fn run(cmd: &str, case: &str, baseline: bool) -> serde_json::Value {
     v
 }
 
-/// Removes the timings and file paths, which differ between runs.
+/// Removes the timings and file paths (the log, the picture, the trajectory CSV), which differ
+/// between runs.
 fn strip(v: &mut serde_json::Value) {
     match v {
         serde_json::Value::Object(map) => {
-            map.retain(|k, _| !k.starts_with("timing") && k != "mcap" && k != "svg");
+            map.retain(|k, _| {
+                !k.starts_with("timing") && !["mcap", "svg", "trajectory_csv"].contains(&k.as_str())
+            });
             map.values_mut().for_each(strip);
         }
         serde_json::Value::Array(items) => items.iter_mut().for_each(strip),

@@ -200,6 +200,18 @@ impl Grasp {
             .points
             .clone()
             .unwrap_or_else(|| (1..=9).map(|j| l * j as f64 / 10.0).collect());
+        if points.is_empty() {
+            return Err(err(
+                "grasp.points",
+                "needs at least one point of action".into(),
+            ));
+        }
+        if points.len() > 10_000 {
+            return Err(err(
+                "grasp.points",
+                format!("at most 10000 points, got {}", points.len()),
+            ));
+        }
         for (i, s) in points.iter().enumerate() {
             if !(s.is_finite() && *s > 0.0 && *s < l) {
                 return Err(err(
@@ -243,10 +255,14 @@ impl Grasp {
                             ));
                         }
                     };
-                    let norm = (v3[0] * v3[0] + v3[1] * v3[1] + v3[2] * v3[2]).sqrt();
-                    if !(norm.is_finite() && norm > 0.0) {
+                    // Scaled by its largest component first, so that huge (or tiny) finite
+                    // components do not overflow (or underflow) the norm.
+                    let big = v3.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+                    if !(big.is_finite() && big > 0.0) {
                         return Err(err(&f, "must be a non-zero finite vector".into()));
                     }
+                    let v3 = v3.map(|c| c / big);
+                    let norm = (v3[0] * v3[0] + v3[1] * v3[1] + v3[2] * v3[2]).sqrt();
                     out.push(v3.map(|c| c / norm));
                 }
                 if out.is_empty() {
@@ -268,6 +284,12 @@ impl Grasp {
             .mu
             .clone()
             .unwrap_or_else(|| (1..=10).map(|j| j as f64 / 10.0).collect());
+        if mu.is_empty() {
+            return Err(err(
+                "grasp.mu",
+                "needs at least one friction coefficient".into(),
+            ));
+        }
         for (i, m) in mu.iter().enumerate() {
             if !(m.is_finite() && *m >= 0.0) {
                 return Err(err(
@@ -280,6 +302,18 @@ impl Grasp {
         let f_max = spec.f_max.unwrap_or(5.0 * n0.max(preload));
         if !(f_max.is_finite() && f_max > 0.0) {
             return Err(err("grasp.f_max", format!("must be positive, got {f_max}")));
+        }
+        // The search bisects [0, f_max]: a cap many decades above the rod's force scale leaves
+        // the bisection at that scale's resolution and reports a margin there.
+        let fu = case.problem.model.rod.force_unit();
+        let f_cap = 1e6 * fu.max(n0).max(preload);
+        if f_max > f_cap {
+            return Err(err(
+                "grasp.f_max",
+                format!(
+                    "{f_max} is more than 10⁶ times the rod's force scale (Rf/L² = {fu:.3e}, the largest initial contact force {n0:.3e}, the preload {preload:.3e}): at most {f_cap:.3e}"
+                ),
+            ));
         }
         if spec.steps == 0 || spec.steps > 10_000 {
             return Err(err(

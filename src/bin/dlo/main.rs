@@ -141,6 +141,15 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    let code = run();
+    if STDOUT_FAILED.load(std::sync::atomic::Ordering::SeqCst) {
+        // The output is lost: that is worse than any verdict but an interruption.
+        return ExitCode::from(EXIT_OUTPUT);
+    }
+    code
+}
+
+fn run() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -214,6 +223,13 @@ fn main() -> ExitCode {
         Command::Inspect { file, json } => run_inspect(&file, json),
         Command::Plot { file, output } => {
             let out = output.unwrap_or_else(|| file.with_extension("svg"));
+            if same_file(&file, &out) {
+                eprintln!(
+                    "error: {}: the picture would overwrite its own log: give another OUT.svg",
+                    out.display()
+                );
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
             run_plot(&file, &out)
         }
     }
@@ -251,13 +267,27 @@ fn single(
     Err(batch::run(command, &files, extra, json, jobs))
 }
 
-/// The log being written, finished by the Ctrl-C handler.
-static ACTIVE_LOG: OnceLock<SharedWriter> = OnceLock::new();
+/// The log being written and its final path, finished and moved into place by the Ctrl-C
+/// (and SIGTERM) handler.
+static ACTIVE_LOG: OnceLock<(SharedWriter, PathBuf)> = OnceLock::new();
 
-/// Opens `dir/<name>.mcap` and arms the Ctrl-C handler to finish it.
+/// Where the log bound for `path` is written until it is finished: a name of this process's own
+/// beside it, so that a run killed hard leaves the previous run's finished log whole (and its
+/// own finished chunks, for `dlo recover`), and two runs at once never write one file.
+fn partial_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".{}.partial", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Opens the log bound for `dir/<name>.mcap` (under [`partial_path`], its header on disk at
+/// once) and arms the Ctrl-C and SIGTERM handler to finish it.
 fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode> {
     let path = dir.join(format!("{name}.mcap"));
-    let w = McapWriter::create(&path).map_err(|e| {
+    let tmp = partial_path(&path);
+    let created = McapWriter::create(&tmp).and_then(|mut w| w.flush().map(|()| w));
+    let w = created.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
         eprintln!(
             "error: {}: cannot create the log: {}",
             path.display(),
@@ -266,11 +296,13 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
         ExitCode::from(EXIT_OUTPUT)
     })?;
     let shared: SharedWriter = Arc::new(Mutex::new(w));
-    if ACTIVE_LOG.set(shared.clone()).is_ok() {
+    if ACTIVE_LOG.set((shared.clone(), path.clone())).is_ok() {
         let _ = ctrlc::set_handler(|| {
-            if let Some(w) = ACTIVE_LOG.get() {
+            if let Some((w, path)) = ACTIVE_LOG.get() {
                 let mut w = dlo_planner::mcap_log::lock(w);
-                let _ = w.finish();
+                if w.finish().is_ok() {
+                    let _ = std::fs::rename(partial_path(path), path);
+                }
             }
             eprintln!("interrupted: the log was finished and is readable");
             std::process::exit(EXIT_INTERRUPTED);
@@ -279,14 +311,21 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
     Ok((shared, path))
 }
 
-/// Finishes a log; reports failure as exit code 1.
+/// Finishes a log and moves it into place; reports failure as exit code 1 and then leaves no
+/// half-written file.
 fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
-    dlo_planner::mcap_log::lock(w).finish().map_err(|e| {
-        eprintln!(
-            "error: {}: cannot finish the log: {}",
-            path.display(),
-            causes(&e)
-        );
+    let tmp = partial_path(path);
+    let mut guard = dlo_planner::mcap_log::lock(w);
+    let was_open = !guard.is_finished();
+    let finished = guard.finish().map_err(|e| causes(&e));
+    drop(guard);
+    let moved = match finished {
+        Ok(()) if was_open => std::fs::rename(&tmp, path).map_err(|e| e.to_string()),
+        other => other,
+    };
+    moved.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        eprintln!("error: {}: cannot finish the log: {e}", path.display());
         ExitCode::from(EXIT_OUTPUT)
     })
 }
@@ -373,9 +412,21 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
 }
 
 /// Writes to stdout, ignoring a closed pipe (e.g. `dlo shape … | head`).
+/// Set when stdout could not be written (other than a closed pipe): the run then exits with 1.
+static STDOUT_FAILED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Writes to stdout. A closed pipe (e.g. `dlo shape … | head`) ends the output quietly; any
+/// other failure (a full device) is reported and makes the exit code 1.
 fn emit(text: &str) {
     use std::io::Write;
-    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    let mut out = std::io::stdout().lock();
+    let written = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+    if let Err(e) = written
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+        && !STDOUT_FAILED.swap(true, std::sync::atomic::Ordering::SeqCst)
+    {
+        eprintln!("error: stdout: cannot write: {e}");
+    }
 }
 
 fn print_report(r: &ShapeReport, json: bool) {
@@ -808,11 +859,22 @@ fn snap_list(snaps: &[f64]) -> String {
         .join(", ")
 }
 
+/// The largest log read by `inspect`, `recover` and `plot` (bytes).
+const MAX_LOG_BYTES: u64 = 4 << 30;
+
 fn read_file(path: &Path) -> Result<Vec<u8>, ExitCode> {
-    std::fs::read(path).map_err(|e| {
+    case::read_capped(path, MAX_LOG_BYTES).map_err(|e| {
         eprintln!("error: {}: cannot read: {e}", path.display());
         ExitCode::from(EXIT_BAD_INPUT)
     })
+}
+
+/// Whether two paths name the same file (an existing one, or the same path as written).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
 }
 
 fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
@@ -820,7 +882,15 @@ fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
         Ok(b) => b,
         Err(c) => return c,
     };
-    let tmp = fixed.with_extension("mcap.partial");
+    if same_file(broken, fixed) {
+        eprintln!(
+            "error: {}: the recovered log would overwrite its input: give another FIXED.mcap",
+            fixed.display()
+        );
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    // Written beside the output under a name of this process's own, never the input's.
+    let tmp = partial_path(fixed);
     let out = match std::fs::File::create(&tmp) {
         Ok(f) => std::io::BufWriter::new(f),
         Err(e) => {
@@ -831,6 +901,7 @@ fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
     match dlo_planner::mcap_log::recover::recover(&bytes, out) {
         Ok(r) => {
             if let Err(e) = std::fs::rename(&tmp, fixed) {
+                let _ = std::fs::remove_file(&tmp);
                 eprintln!("error: {}: cannot write: {e}", fixed.display());
                 return ExitCode::from(EXIT_OUTPUT);
             }
@@ -846,6 +917,12 @@ fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
                 }
             ));
             ExitCode::SUCCESS
+        }
+        // Reading is from memory: an I/O error is the output's.
+        Err(mcap::McapError::Io(e)) => {
+            let _ = std::fs::remove_file(&tmp);
+            eprintln!("error: {}: cannot write: {e}", fixed.display());
+            ExitCode::from(EXIT_OUTPUT)
         }
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
