@@ -142,6 +142,13 @@ fn unfinished_log_is_recovered() {
         0.01,
         dlo_planner::mcap_log::scene::color(1.0, 0.0, 0.0, 1.0),
     );
+    // A scene a viewer can show: the frame transform first, as every log has it.
+    w.proto(
+        "/tf",
+        0,
+        &dlo_planner::mcap_log::scene::gravity_transform(0),
+    )
+    .unwrap();
     for i in 0..500u64 {
         w.proto("/rod/optimal", i * 1000, &up).unwrap();
     }
@@ -164,7 +171,8 @@ fn unfinished_log_is_recovered() {
     assert!(r.messages >= 500, "{}", r.messages);
     let fixed = fixed.into_inner();
     let counts = check_log(&fixed);
-    assert_eq!(counts["/rod/optimal"] as u64, r.messages);
+    assert_eq!(counts.values().sum::<usize>() as u64, r.messages);
+    assert_eq!(counts["/tf"], 1);
     std::fs::write(log_dir().join("recovered_unit.mcap"), &fixed).unwrap();
 }
 

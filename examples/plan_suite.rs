@@ -1,0 +1,331 @@
+//! The generated planning suite: problems in the style a cable-routing user writes, with every
+//! planner setting at its default, planned, verified and replayed, and the outcome counted.
+//!
+//!     cargo run --release --example plan_suite -- --seed 1
+//!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
+//!
+//! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
+//! three obstacles (boxes, balls, capsules along y) beyond its swing, start and goal end poses
+//! on either side of the z axis, with and without a prescribed end angle, some with weight.
+//! 3D: a cable with torsion (L = 1, Rf = 1, Rt = 0.77, r = 0.01) clamped by its frame at the
+//! origin (θ(0) = 0, φ(0) + ψ(0) = 0), one or two obstacles among capsule bars, cylinders,
+//! balls, boxes and the triangle-mesh cube of `planning_cases/meshes`, start and goal
+//! positions on opposite sides with tangents and twists. Problems whose start or goal has no
+//! static shape (or lies inside an obstacle) are generated again and not counted.
+//!
+//! For each problem: whether the plan is collision-free (`planned`) and coincides with its
+//! replay, whether the replay snaps, the plan time (end solves, plan, verification and
+//! replay), the gripper's path length over the straight-line distance between its ends, and an
+//! independent clearance check of every plan called collision-free on a grid twice as fine in
+//! k as the verification's, at the model's own boundary points (the worst of these is the
+//! "worst false collision-free" of the table: it must be ≥ −1e-6 L).
+
+use dlo_planner::case;
+use dlo_planner::kinematics::Shape;
+use dlo_planner::planner::observer::Silent;
+use dlo_planner::planner::{PlanResult, PlanStatus, Planner};
+use std::path::Path;
+use std::time::Instant;
+
+/// splitmix64: a small, fixed pseudo-random sequence (the suite must not depend on a crate's
+/// generator changing).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [a, b).
+    fn uniform(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+fn planar_problem(rng: &mut Rng, i: usize) -> String {
+    let n_obs = 1 + rng.below(3);
+    let mut obstacles = Vec::new();
+    for j in 0..n_obs {
+        let x = rng.uniform(-0.25, 0.25);
+        let z = rng.uniform(0.75, 1.15);
+        let shape = match rng.below(3) {
+            0 => format!(
+                r#"{{"type": "cuboid", "half_extents": [{}, 0.5, {}]}}"#,
+                rng.uniform(0.04, 0.2),
+                rng.uniform(0.04, 0.3)
+            ),
+            1 => format!(
+                r#"{{"type": "ball", "radius": {}}}"#,
+                rng.uniform(0.04, 0.15)
+            ),
+            _ => format!(
+                r#"{{"type": "capsule", "a": [0, -0.5, 0], "b": [0, 0.5, 0], "radius": {}}}"#,
+                rng.uniform(0.03, 0.1)
+            ),
+        };
+        obstacles.push(format!(
+            r#"{{"name": "o{j}", "shape": {shape}, "position": [{x}, 0, {z}]}}"#
+        ));
+    }
+    let end = |rng: &mut Rng, side: f64| {
+        let r = rng.uniform(0.55, 0.9);
+        let a = side * rng.uniform(0.25, 0.7);
+        let (x, z) = (r * a.sin(), r * a.cos());
+        if rng.below(3) == 0 {
+            format!(r#"{{"x": {x}, "z": {z}}}"#)
+        } else {
+            format!(
+                r#"{{"x": {x}, "z": {z}, "theta": {}}}"#,
+                side * rng.uniform(0.2, 1.2)
+            )
+        }
+    };
+    let (start, goal) = (end(rng, 1.0), end(rng, -1.0));
+    let weight = if rng.below(4) == 0 {
+        format!(r#", "weight_per_length": {}"#, rng.uniform(0.5, 3.0))
+    } else {
+        String::new()
+    };
+    format!(
+        r#"{{"name": "planar_{i}", "planar": true,
+  "rod": {{"length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005{weight}}},
+  "constraints": [{{"type": "orientation", "s": 0.0, "theta": 0.0}}],
+  "obstacles": [{}],
+  "plan": {{"start": {start}, "goal": {goal}}}}}"#,
+        obstacles.join(", ")
+    )
+}
+
+fn spatial_problem(rng: &mut Rng, i: usize) -> String {
+    let n_obs = 1 + rng.below(2);
+    let mut obstacles = Vec::new();
+    // The ends' azimuths: the goal on the other side of the z axis.
+    let az0 = rng.uniform(0.0, std::f64::consts::TAU);
+    let az1 = az0 + std::f64::consts::PI + rng.uniform(-0.8, 0.8);
+    for j in 0..n_obs {
+        // Near the cable's natural axis, beyond the clamp, where the straight-line path sweeps.
+        let p = [
+            rng.uniform(-0.2, 0.2),
+            rng.uniform(-0.2, 0.2),
+            rng.uniform(0.75, 1.1),
+        ];
+        let shape = match rng.below(5) {
+            0 => format!(
+                r#"{{"type": "capsule", "a": [0, -1, 0], "b": [0, 1, 0], "radius": {}}}, "rotation": [0, 0, {}]"#,
+                rng.uniform(0.04, 0.1),
+                rng.uniform(0.0, 3.14)
+            ),
+            1 => format!(
+                r#"{{"type": "cylinder", "half_height": 1.0, "radius": {}}}, "rotation": [0, 0, -1.5707963267948966]"#,
+                rng.uniform(0.04, 0.1)
+            ),
+            2 => format!(
+                r#"{{"type": "ball", "radius": {}}}"#,
+                rng.uniform(0.05, 0.15)
+            ),
+            3 => format!(
+                r#"{{"type": "cuboid", "half_extents": [{}, {}, {}]}}"#,
+                rng.uniform(0.04, 0.15),
+                rng.uniform(0.04, 0.15),
+                rng.uniform(0.04, 0.15)
+            ),
+            _ => format!(
+                r#"{{"type": "triangle_mesh", "obj": "meshes/cube.obj", "scale": {}}}"#,
+                rng.uniform(0.1, 0.3)
+            ),
+        };
+        obstacles.push(format!(
+            r#"{{"name": "o{j}", "shape": {shape}, "position": [{}, {}, {}]}}"#,
+            p[0], p[1], p[2]
+        ));
+    }
+    let end = |rng: &mut Rng, az: f64| {
+        let r = rng.uniform(0.6, 0.9);
+        let polar = rng.uniform(0.2, 0.6);
+        let pos = [
+            r * polar.sin() * az.cos(),
+            r * polar.sin() * az.sin(),
+            r * polar.cos(),
+        ];
+        let tilt = polar + rng.uniform(0.2, 0.6);
+        let t = [tilt.sin() * az.cos(), tilt.sin() * az.sin(), tilt.cos()];
+        format!(
+            r#"{{"position": [{}, {}, {}], "tangent": [{}, {}, {}], "twist": {}}}"#,
+            pos[0],
+            pos[1],
+            pos[2],
+            t[0],
+            t[1],
+            t[2],
+            rng.uniform(-0.5, 0.5)
+        )
+    };
+    let (start, goal) = (end(rng, az0), end(rng, az1));
+    format!(
+        r#"{{"name": "spatial_{i}", "planar": false,
+  "rod": {{"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.77, "radius": 0.01}},
+  "constraints": [{{"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}}],
+  "obstacles": [{}],
+  "plan": {{"start": {start}, "goal": {goal}}}}}"#,
+        obstacles.join(", ")
+    )
+}
+
+/// One problem's outcome.
+struct Outcome {
+    name: String,
+    planned: bool,
+    coincide: bool,
+    snaps: bool,
+    seconds: f64,
+    travel: f64,
+    /// The independent check's smallest clearance (units of L), for plans called collision-free.
+    checked_clearance: Option<f64>,
+    u_max: f64,
+    deviation: f64,
+}
+
+/// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
+/// model's boundary points (units of L).
+fn independent_clearance(p: &Planner, r: &PlanResult) -> f64 {
+    let model = &p.base.model;
+    let l = model.rod.length;
+    let path = p.with_terms(r.path_terms).path();
+    let n = 2 * (p.options.verify_k - 1);
+    let mut a = vec![0.0; path.n()];
+    let mut shape = Shape::default();
+    let mut worst = f64::INFINITY;
+    for i in 0..=n {
+        path.shape_at(&r.z, i as f64 / n as f64, &mut a);
+        model.evaluate_into(&a, &mut shape);
+        for x in &shape.positions {
+            for o in &p.obstacles {
+                let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
+                worst = worst.min(d / l);
+            }
+        }
+    }
+    worst
+}
+
+fn run(text: &str, name: &str) -> Option<Outcome> {
+    let c = case::parse(
+        text,
+        &Path::new("planning_cases").join(format!("{name}.json")),
+    )
+    .ok()?;
+    let t0 = Instant::now();
+    let p = Planner::from_case(&c).ok()?;
+    let r = p.run(&mut Silent);
+    let seconds = t0.elapsed().as_secs_f64();
+    let planned = r.status == PlanStatus::Planned;
+    let t = &r.trajectory;
+    Some(Outcome {
+        name: name.to_string(),
+        planned,
+        coincide: planned && r.replay.coincide,
+        snaps: !r.replay.snaps.is_empty(),
+        seconds,
+        travel: t.path_length / t.straight_distance.max(1e-12),
+        checked_clearance: planned.then(|| independent_clearance(&p, &r)),
+        u_max: r.u_max,
+        deviation: r.replay.max_deviation_over_l,
+    })
+}
+
+fn percentile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let i = ((v.len() - 1) as f64 * q).round() as usize;
+    v[i]
+}
+
+fn table(kind: &str, out: &[Outcome]) -> String {
+    let n = out.len();
+    let planned = out.iter().filter(|o| o.planned).count();
+    let coincide = out.iter().filter(|o| o.coincide).count();
+    let snaps = out.iter().filter(|o| o.snaps).count();
+    let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
+    let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
+    let worst = out
+        .iter()
+        .filter_map(|o| o.checked_clearance)
+        .fold(f64::INFINITY, f64::min);
+    let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
+    format!(
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        pct(planned),
+        pct(coincide),
+        percentile(&mut times.clone(), 0.5),
+        percentile(&mut times, 0.95),
+        worst,
+        percentile(&mut travel.clone(), 0.5),
+        percentile(&mut travel, 0.95),
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let arg = |flag: &str, default: u64| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .map_or(default, |v| v.parse().expect("a number"))
+    };
+    let seed = arg("--seed", 1);
+    let n_planar = arg("--planar", 60) as usize;
+    let n_spatial = arg("--spatial", 30) as usize;
+    let verbose = args.iter().any(|a| a == "--verbose");
+    let mut rng = Rng(seed);
+    let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
+    let mut regenerated = [0usize; 2];
+    for (kind, count) in [(0, n_planar), (1, n_spatial)] {
+        let mut i = 0;
+        while results[kind].len() < count {
+            let name = format!("{}_{seed}_{i}", ["planar", "spatial"][kind]);
+            let text = if kind == 0 {
+                planar_problem(&mut rng, i)
+            } else {
+                spatial_problem(&mut rng, i)
+            };
+            i += 1;
+            match run(&text, &name) {
+                Some(o) => {
+                    if verbose {
+                        eprintln!(
+                            "{:16} planned {:5} coincide {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s",
+                            o.name,
+                            o.planned,
+                            o.coincide,
+                            o.snaps,
+                            o.u_max,
+                            o.deviation,
+                            o.travel,
+                            o.seconds
+                        );
+                    }
+                    results[kind].push(o);
+                }
+                None => regenerated[kind] += 1,
+            }
+        }
+    }
+    println!(
+        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), every planner setting at its default.\n",
+        n_planar, n_spatial, regenerated[0], regenerated[1]
+    );
+    println!(
+        "| problems | n | collision-free | coincide with replay | snap | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    print!("{}", table("planar", &results[0]));
+    print!("{}", table("3D", &results[1]));
+}
