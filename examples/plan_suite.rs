@@ -3,6 +3,7 @@
 //!
 //!     cargo run --release --example plan_suite -- --seed 1
 //!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
+//!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!
 //! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
 //! three obstacles (boxes, balls, capsules along y) beyond its swing, start and goal end poses
@@ -185,41 +186,46 @@ struct Outcome {
     snaps: bool,
     seconds: f64,
     travel: f64,
-    /// The independent check's smallest clearance (units of L), for plans called collision-free.
-    checked_clearance: Option<f64>,
+    /// The independent check's smallest clearance (units of L) and its k, for plans called
+    /// collision-free.
+    checked_clearance: Option<(f64, f64)>,
     u_max: f64,
     deviation: f64,
 }
 
 /// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
-/// model's boundary points (units of L).
-fn independent_clearance(p: &Planner, r: &PlanResult) -> f64 {
+/// model's boundary points (units of L), and where in k.
+fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = &p.base.model;
     let l = model.rod.length;
     let path = p.with_terms(r.path_terms).path();
     let n = 2 * (p.options.verify_k - 1);
     let mut a = vec![0.0; path.n()];
     let mut shape = Shape::default();
-    let mut worst = f64::INFINITY;
+    let mut worst = (f64::INFINITY, 0.0);
     for i in 0..=n {
-        path.shape_at(&r.z, i as f64 / n as f64, &mut a);
+        let k = i as f64 / n as f64;
+        path.shape_at(&r.z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
         for x in &shape.positions {
             for o in &p.obstacles {
                 let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
-                worst = worst.min(d / l);
+                if d / l < worst.0 {
+                    worst = (d / l, k);
+                }
             }
         }
     }
     worst
 }
 
-fn run(text: &str, name: &str) -> Option<Outcome> {
-    let c = case::parse(
-        text,
-        &Path::new("planning_cases").join(format!("{name}.json")),
-    )
-    .ok()?;
+fn run(text: &str, name: &str, plan: &serde_json::Value) -> Option<Outcome> {
+    let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
+    for (key, value) in plan.as_object().into_iter().flatten() {
+        v["plan"][key] = value.clone();
+    }
+    let path = Path::new("planning_cases").join(format!("{name}.json"));
+    let c = case::parse(&v.to_string(), &path).ok()?;
     let t0 = Instant::now();
     let p = Planner::from_case(&c).ok()?;
     let r = p.run(&mut Silent);
@@ -257,7 +263,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
     let worst = out
         .iter()
-        .filter_map(|o| o.checked_clearance)
+        .filter_map(|o| o.checked_clearance.map(|c| c.0))
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
@@ -284,6 +290,15 @@ fn main() {
     let n_planar = arg("--planar", 60) as usize;
     let n_spatial = arg("--spatial", 30) as usize;
     let verbose = args.iter().any(|a| a == "--verbose");
+    // `--plan '{"path_terms": 4}'`: planner settings given to every problem (to measure other
+    // settings on the same problems); none by default.
+    let plan: serde_json::Value = args
+        .iter()
+        .position(|a| a == "--plan")
+        .and_then(|i| args.get(i + 1))
+        .map_or(serde_json::json!({}), |t| {
+            serde_json::from_str(t).expect("--plan: a JSON object")
+        });
     let mut rng = Rng(seed);
     let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut regenerated = [0usize; 2];
@@ -297,11 +312,11 @@ fn main() {
                 spatial_problem(&mut rng, i)
             };
             i += 1;
-            match run(&text, &name) {
+            match run(&text, &name, &plan) {
                 Some(o) => {
                     if verbose {
                         eprintln!(
-                            "{:16} planned {:5} coincide {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s",
+                            "{:16} planned {:5} coincide {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4}",
                             o.name,
                             o.planned,
                             o.coincide,
@@ -309,7 +324,9 @@ fn main() {
                             o.u_max,
                             o.deviation,
                             o.travel,
-                            o.seconds
+                            o.seconds,
+                            o.checked_clearance.map_or(f64::NAN, |c| c.0),
+                            o.checked_clearance.map_or(f64::NAN, |c| c.1)
                         );
                     }
                     results[kind].push(o);
@@ -319,8 +336,16 @@ fn main() {
         }
     }
     println!(
-        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), every planner setting at its default.\n",
-        n_planar, n_spatial, regenerated[0], regenerated[1]
+        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), planner settings {}.\n",
+        n_planar,
+        n_spatial,
+        regenerated[0],
+        regenerated[1],
+        if plan.as_object().is_none_or(|o| o.is_empty()) {
+            "all at their defaults".to_string()
+        } else {
+            plan.to_string()
+        }
     );
     println!(
         "| problems | n | collision-free | coincide with replay | snap | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"

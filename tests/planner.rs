@@ -1343,3 +1343,22 @@ fn a_3d_cable_plans_from_its_poses_alone() {
     assert!(r.min_clearance.unwrap() >= 0.0);
     assert!(r.replay.coincide, "{}", r.replay.max_deviation_over_l);
 }
+
+/// The verification checks between its grid values: the paper's straight-line path, which runs
+/// 0.205 L deep into the block halfway, verified on a grid of only k = 0 and k = 1 (both end
+/// shapes clear of the block): the chord bound between them is negative, so the interval is
+/// bisected and the penetration found (the first midpoint is k = 0.5, where the grid of 201
+/// finds −0.205 L as well).
+#[test]
+fn verification_finds_tunnelling_between_its_grid_values() {
+    let (p, _) = paper();
+    let fine = fine_model(&p.base.model, 256, 4);
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let full = verify(&fine, &path, &z, 201, &p.obstacles, p.base.objective);
+    let sparse = verify(&fine, &path, &z, 2, &p.obstacles, p.base.objective);
+    let (cf, cs) = (full.min_clearance.unwrap(), sparse.min_clearance.unwrap());
+    assert!(cf < -0.2, "{cf}");
+    assert!(cs <= cf + 1e-12, "two grid values find {cs}, 201 find {cf}");
+    assert!(!sparse.collision_free(1e-6));
+}

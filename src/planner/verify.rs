@@ -72,7 +72,70 @@ impl Verification {
     }
 }
 
-/// Evaluates `path(z)` on `k_samples` uniform values of `k` with the fine model.
+/// The smallest chord bound `(g(p) + g(q) − |q − p|)/2` of any point and obstacle between two
+/// shapes (case units).
+fn chord_bound(a: &(Vec<[f64; 3]>, Vec<Vec<f64>>), b: &(Vec<[f64; 3]>, Vec<Vec<f64>>)) -> f64 {
+    let mut lo = f64::INFINITY;
+    for (ga, gb) in a.1.iter().zip(&b.1) {
+        for j in 0..a.0.len() {
+            let (p, q) = (a.0[j], b.0[j]);
+            let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+            lo = lo.min(0.5 * (ga[j] + gb[j] - d));
+        }
+    }
+    lo
+}
+
+/// Bisects `(k0, k1)` while the chord bound between its ends is negative, up to `depth` times,
+/// recording every evaluated shape's clearances in `worst`.
+#[allow(clippy::too_many_arguments)]
+fn between(
+    fine: &Model,
+    path: &DeformationPath,
+    z: &[f64],
+    obstacles: &[Arc<Obstacle>],
+    lo: (f64, &(Vec<[f64; 3]>, Vec<Vec<f64>>)),
+    hi: (f64, &(Vec<[f64; 3]>, Vec<Vec<f64>>)),
+    depth: usize,
+    worst: &mut [ObstacleClearance],
+) {
+    if depth == 0 || chord_bound(lo.1, hi.1) >= 0.0 {
+        return;
+    }
+    let (l, r) = (fine.rod.length, fine.rod.radius);
+    let k = 0.5 * (lo.0 + hi.0);
+    let mut a = vec![0.0; path.n()];
+    path.shape_at(z, k, &mut a);
+    let pts: Vec<[f64; 3]> = fine
+        .evaluate(&a)
+        .positions
+        .iter()
+        .map(|p| p.map(|v| v * l))
+        .collect();
+    let gaps: Vec<Vec<f64>> = obstacles
+        .iter()
+        .map(|o| {
+            pts.iter()
+                .map(|&p| o.signed_distance_value(p) - r)
+                .collect()
+        })
+        .collect();
+    for (g, w) in gaps.iter().zip(worst.iter_mut()) {
+        for (b, &gap) in g.iter().enumerate() {
+            if gap < w.clearance {
+                w.clearance = gap;
+                w.k = k;
+                w.s = fine.mesh.boundaries[b] * l;
+            }
+        }
+    }
+    let mid = (pts, gaps);
+    between(fine, path, z, obstacles, lo, (k, &mid), depth - 1, worst);
+    between(fine, path, z, obstacles, (k, &mid), hi, depth - 1, worst);
+}
+
+/// Evaluates `path(z)` on `k_samples` uniform values of `k` with the fine model, and between
+/// them wherever a point could reach an obstacle (see [`verify_with`]).
 pub fn verify(
     fine: &Model,
     path: &DeformationPath,
@@ -128,11 +191,26 @@ pub fn verify_with(
             s: 0.0,
         })
         .collect();
+    // Each grid shape's positions (case units) and, per obstacle, every point's surface gap,
+    // for the check between grid values below.
+    let mut grid: Vec<(Vec<[f64; 3]>, Vec<Vec<f64>>)> = Vec::with_capacity(k_samples);
     for &k in &ks {
         path.shape_at(z, k, &mut a);
         fine.evaluate_into(&a, &mut shape);
         let t = fine.energy(&a, &shape, objective, None);
         energies.push(unit * t.value(objective));
+        if !obstacles.is_empty() {
+            let pts: Vec<[f64; 3]> = shape.positions.iter().map(|p| p.map(|v| v * l)).collect();
+            let gaps = obstacles
+                .iter()
+                .map(|o| {
+                    pts.iter()
+                        .map(|&p| o.signed_distance_value(p) - r)
+                        .collect()
+                })
+                .collect();
+            grid.push((pts, gaps));
+        }
         for &(i, j) in &pairs {
             let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
             let (_, _, d) = crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
@@ -141,16 +219,34 @@ pub fn verify_with(
                 worst_self = Some((gap, k));
             }
         }
-        for (o, w) in obstacles.iter().zip(worst.iter_mut()) {
-            for (b, p) in shape.positions.iter().enumerate() {
-                let (d, _) = o.signed_distance(p.map(|v| v * l));
-                if d - r < w.clearance {
-                    w.clearance = d - r;
-                    w.k = k;
-                    w.s = fine.mesh.boundaries[b] * l;
+        if let Some((_, gaps)) = grid.last() {
+            for (g, w) in gaps.iter().zip(worst.iter_mut()) {
+                for (b, &gap) in g.iter().enumerate() {
+                    if gap < w.clearance {
+                        w.clearance = gap;
+                        w.k = k;
+                        w.s = fine.mesh.boundaries[b] * l;
+                    }
                 }
             }
         }
+    }
+    // Between grid values: a point moving from p to q keeps at least (g(p) + g(q) − |q − p|)/2
+    // from an obstacle along the chord (the gap g is 1-Lipschitz). Where that bound goes below
+    // zero, the interval is bisected (to 1/64 of it) and every shape evaluated there counts, so
+    // that a path tunnelling between grid values is found instead of called collision-free.
+    for w in 0..grid.len().saturating_sub(1) {
+        let (k0, k1) = (ks[w], ks[w + 1]);
+        between(
+            fine,
+            path,
+            z,
+            obstacles,
+            (k0, &grid[w]),
+            (k1, &grid[w + 1]),
+            6,
+            &mut worst,
+        );
     }
     let (jmax, &u_max) = energies
         .iter()
