@@ -273,8 +273,8 @@ fn paper_replay_coincides_from_other_starts() {
 /// by the last equilibrium-tracking pass). With seed 1 the first start's estimate is 1.46 % of
 /// L, the second start does not run, and the replay confirms the estimate (measured equal to
 /// 1e-15: the replay takes the same 41 steps, and the strip stays clear of the block). With
-/// seed 5 the first start's plan is estimated at 2.89 %, so the second start (seed 6) runs and
-/// is chosen; it is the single start of seed 6 bit for bit.
+/// seed 14 the first start's plan is estimated at 2.48 %, so the second start (seed 15) runs and
+/// is chosen; it is the single start of seed 15 bit for bit.
 #[test]
 fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let (p, r) = paper();
@@ -293,7 +293,7 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
         r.replay.max_deviation_over_l
     );
 
-    let r5 = paper_with(serde_json::json!({ "seed": 5 }));
+    let r5 = paper_with(serde_json::json!({ "seed": 14 }));
     assert_eq!(
         (r5.starts.len(), r5.starts_not_run, r5.chosen_start),
         (2, 0, 1)
@@ -302,7 +302,7 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     assert!(first > 0.02, "{first}");
     assert!(r5.starts[1].equilibrium_deviation.expect("measured") <= 0.02);
     assert!(r5.replay.coincide);
-    let six = paper_with(serde_json::json!({ "seed": 6, "starts": 1, "parallel_starts": 1 }));
+    let six = paper_with(serde_json::json!({ "seed": 15, "starts": 1, "parallel_starts": 1 }));
     assert_eq!(six.path, r5.path);
     assert_eq!(six.u_max.to_bits(), r5.u_max.to_bits());
 }
@@ -376,12 +376,12 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
 }
 
 /// Each start is verified and refined before the starts compete, so two starts are as good as
-/// the better of them: with seeds 33–34, start 33's samples peak lower before refinement, but
-/// refined its plan peaks at 5.41 and departs from its replay, while start 34's refined plan
-/// peaks at 5.28 and coincides (README, planning results). The pair keeps start 34's.
+/// the better of them: with seeds 16–17, start 16's refined plan peaks at 5.39 and is estimated
+/// to depart from its replay (2.48 % of L), while start 17's refined plan peaks at 5.24 and
+/// coincides. The pair keeps start 17's.
 #[test]
 fn paper_two_starts_keep_the_better_verified_plan() {
-    let r = paper_with(serde_json::json!({ "seed": 33 }));
+    let r = paper_with(serde_json::json!({ "seed": 16 }));
     assert_eq!(r.status, PlanStatus::Planned);
     assert_eq!(r.starts.len(), 2);
     assert!(r.starts.iter().all(|s| s.collision_free));
@@ -1018,16 +1018,27 @@ fn pillar_case_3d_coincides() {
 }
 
 /// Without the swept-clearance rows the pillar case's optimiser moves the cable through the
-/// pillar between two samples, and each refinement round only moves the crossing into another
-/// gap: after every round the verification grid still finds it inside the pillar.
+/// pillar between two samples. The verification finds the crossing between its own grid
+/// values (where the chord bound is negative it bisects), sample refinement adds the k it
+/// finds, and the refined plan clears the pillar (measured +1.45e-5 after five added samples,
+/// four of them between the verification's grid values) and coincides with its replay. (When
+/// the verification looked only at its 201 grid values, each round moved the crossing into
+/// another gap and the plan ended in a collision.)
 #[test]
 fn pillar_case_tunnels_without_swept_clearance() {
     let c = shipped_variant("plan_cable_around_pillar.json", |v| {
         v["plan"]["swept_clearance"] = serde_json::json!(false);
     });
     let r = Planner::from_case(&c).unwrap().run(&mut Silent);
-    assert_eq!(r.status, PlanStatus::Collision);
-    assert!(r.min_clearance.unwrap() < -0.01, "{:?}", r.min_clearance);
+    assert_eq!(r.status, PlanStatus::Planned);
+    assert!(r.min_clearance.unwrap() >= 0.0, "{:?}", r.min_clearance);
+    assert!(r.replay.coincide);
+    let off_grid = r
+        .added_samples
+        .iter()
+        .filter(|k| ((*k * 200.0).round() - *k * 200.0).abs() > 1e-9)
+        .count();
+    assert!(off_grid > 0, "{:?}", r.added_samples);
     assert!(!r.added_samples.is_empty());
 }
 
