@@ -450,6 +450,17 @@ fn draw_view(
             }
         }
     }
+    draw_legend(&mut chart)
+}
+
+/// The legend of a chart's labelled series, in its upper right corner.
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+) -> Result<(), PlotError> {
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
@@ -457,8 +468,7 @@ fn draw_view(
         .border_style(BLACK.mix(0.3))
         .label_font(("sans-serif", 11))
         .draw()
-        .map_err(draw_err)?;
-    Ok(())
+        .map_err(draw_err)
 }
 
 /// A vertical colour bar of [`ramp`] from `k = 0` (bottom) to 1 (top).
@@ -545,15 +555,7 @@ fn draw_energy(area: &DrawingArea<SVGBackend, Shift>, f: &PlanFrames) -> Result<
                 PathElement::new([(x, y), (x + 14, y)], colour.stroke_width(width))
             });
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK.mix(0.3))
-        .label_font(("sans-serif", 11))
-        .draw()
-        .map_err(draw_err)?;
-    Ok(())
+    draw_legend(&mut chart)
 }
 
 /// Writes the SVG picture of `frames` to `path`; `title` heads it. A plan gets its views, a

@@ -7,22 +7,11 @@
 //!
 //! and the diff of `tests/golden/` is reviewed with it.
 
+mod common;
+
+use common::strip;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// Removes what differs between runs of the same build: timings and file paths.
-fn strip(v: &mut serde_json::Value) {
-    match v {
-        serde_json::Value::Object(map) => {
-            map.retain(|k, _| {
-                !k.starts_with("timing") && !["mcap", "svg", "trajectory_csv"].contains(&k.as_str())
-            });
-            map.values_mut().for_each(strip);
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(strip),
-        _ => {}
-    }
-}
 
 #[test]
 fn shipped_reports_match_the_golden_files() {

@@ -4,6 +4,9 @@
 //! the baseline path. On a processor without AVX2 both runs take the baseline path and the test
 //! checks nothing more than reproducibility.
 
+mod common;
+
+use common::strip;
 use std::path::Path;
 use std::process::Command;
 
@@ -31,21 +34,6 @@ fn run(cmd: &str, case: &str, baseline: bool) -> serde_json::Value {
         serde_json::from_str(&text).unwrap_or_else(|e| panic!("{cmd} {case}: {e}: {text}"));
     strip(&mut v);
     v
-}
-
-/// Removes the timings and file paths (the log, the picture, the trajectory CSV), which differ
-/// between runs.
-fn strip(v: &mut serde_json::Value) {
-    match v {
-        serde_json::Value::Object(map) => {
-            map.retain(|k, _| {
-                !k.starts_with("timing") && !["mcap", "svg", "trajectory_csv"].contains(&k.as_str())
-            });
-            map.values_mut().for_each(strip);
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(strip),
-        _ => {}
-    }
 }
 
 #[test]

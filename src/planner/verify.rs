@@ -72,6 +72,39 @@ impl Verification {
     }
 }
 
+/// A shape's points in case units (from its dimensionless `positions`) and, per obstacle, every
+/// point's surface gap `d − r`.
+fn gaps_at(
+    fine: &Model,
+    obstacles: &[Arc<Obstacle>],
+    positions: &[[f64; 3]],
+) -> (Vec<[f64; 3]>, Vec<Vec<f64>>) {
+    let (l, r) = (fine.rod.length, fine.rod.radius);
+    let pts: Vec<[f64; 3]> = positions.iter().map(|p| p.map(|v| v * l)).collect();
+    let gaps = obstacles
+        .iter()
+        .map(|o| {
+            pts.iter()
+                .map(|&p| o.signed_distance_value(p) - r)
+                .collect()
+        })
+        .collect();
+    (pts, gaps)
+}
+
+/// Records the gaps of the shape at `k` in each obstacle's worst clearance.
+fn record(fine: &Model, gaps: &[Vec<f64>], k: f64, worst: &mut [ObstacleClearance]) {
+    for (g, w) in gaps.iter().zip(worst.iter_mut()) {
+        for (b, &gap) in g.iter().enumerate() {
+            if gap < w.clearance {
+                w.clearance = gap;
+                w.k = k;
+                w.s = fine.mesh.boundaries[b] * fine.rod.length;
+            }
+        }
+    }
+}
+
 /// The smallest chord bound `(g(p) + g(q) − |q − p|)/2` of any point and obstacle between two
 /// shapes (case units).
 fn chord_bound(a: &(Vec<[f64; 3]>, Vec<Vec<f64>>), b: &(Vec<[f64; 3]>, Vec<Vec<f64>>)) -> f64 {
@@ -102,34 +135,11 @@ fn between(
     if depth == 0 || chord_bound(lo.1, hi.1) >= 0.0 {
         return;
     }
-    let (l, r) = (fine.rod.length, fine.rod.radius);
     let k = 0.5 * (lo.0 + hi.0);
     let mut a = vec![0.0; path.n()];
     path.shape_at(z, k, &mut a);
-    let pts: Vec<[f64; 3]> = fine
-        .evaluate(&a)
-        .positions
-        .iter()
-        .map(|p| p.map(|v| v * l))
-        .collect();
-    let gaps: Vec<Vec<f64>> = obstacles
-        .iter()
-        .map(|o| {
-            pts.iter()
-                .map(|&p| o.signed_distance_value(p) - r)
-                .collect()
-        })
-        .collect();
-    for (g, w) in gaps.iter().zip(worst.iter_mut()) {
-        for (b, &gap) in g.iter().enumerate() {
-            if gap < w.clearance {
-                w.clearance = gap;
-                w.k = k;
-                w.s = fine.mesh.boundaries[b] * l;
-            }
-        }
-    }
-    let mid = (pts, gaps);
+    let mid = gaps_at(fine, obstacles, &fine.evaluate(&a).positions);
+    record(fine, &mid.1, k, worst);
     between(fine, path, z, obstacles, lo, (k, &mid), depth - 1, worst);
     between(fine, path, z, obstacles, (k, &mid), hi, depth - 1, worst);
 }
@@ -200,16 +210,7 @@ pub fn verify_with(
         let t = fine.energy(&a, &shape, objective, None);
         energies.push(unit * t.value(objective));
         if !obstacles.is_empty() {
-            let pts: Vec<[f64; 3]> = shape.positions.iter().map(|p| p.map(|v| v * l)).collect();
-            let gaps = obstacles
-                .iter()
-                .map(|o| {
-                    pts.iter()
-                        .map(|&p| o.signed_distance_value(p) - r)
-                        .collect()
-                })
-                .collect();
-            grid.push((pts, gaps));
+            grid.push(gaps_at(fine, obstacles, &shape.positions));
         }
         for &(i, j) in &pairs {
             let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
@@ -220,15 +221,7 @@ pub fn verify_with(
             }
         }
         if let Some((_, gaps)) = grid.last() {
-            for (g, w) in gaps.iter().zip(worst.iter_mut()) {
-                for (b, &gap) in g.iter().enumerate() {
-                    if gap < w.clearance {
-                        w.clearance = gap;
-                        w.k = k;
-                        w.s = fine.mesh.boundaries[b] * l;
-                    }
-                }
-            }
+            record(fine, gaps, k, &mut worst);
         }
     }
     // Between grid values: a point moving from p to q keeps at least (g(p) + g(q) − |q − p|)/2

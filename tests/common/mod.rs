@@ -160,3 +160,18 @@ pub fn spiral_case(self_contact: bool) -> dlo_planner::case::Case {
     );
     dlo_planner::case::parse(&text, std::path::Path::new("spiral.json")).unwrap()
 }
+
+/// Removes from a JSON report what differs between runs of one build: timings and file paths
+/// (the log, the picture, the trajectory CSV).
+pub fn strip(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            map.retain(|k, _| {
+                !k.starts_with("timing") && !["mcap", "svg", "trajectory_csv"].contains(&k.as_str())
+            });
+            map.values_mut().for_each(strip);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(strip),
+        _ => {}
+    }
+}
