@@ -125,16 +125,18 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Box<dyn Const
 
 /// The start or goal shape: `end`'s coefficients as given, or the static solve of its pose,
 /// started from its coefficients, else (a 3D end with all three angles) from a shape bent
-/// from the held frame `seed.0` towards its own `seed.1`, else from the case's initial shape.
+/// from the held frame `held` (see [`held_frame`]) towards its own, else from the case's
+/// initial shape.
 fn end_shape(
     case: &Case,
     field: &str,
     end: &End,
+    held: ([f64; 3], bool),
     opts: &StaticOptions,
 ) -> Result<StaticSolution, Error> {
     let seed = end_angles(end)
         .filter(|_| case.problem.model.layout.spatial)
-        .map(|e| (held_frame(case), e));
+        .map(|e| (held, e));
     let base = &case.problem;
     let pose = EndPose {
         position: end.position.clone(),
@@ -144,7 +146,7 @@ fn end_shape(
             .map(|&(f, v)| (Angle::Field(f), v))
             .collect(),
     };
-    let sol = if end.position.is_empty() && end.angles.is_empty() {
+    let sol = if !end.is_pose() {
         let a = end.shape.clone().expect("validated: shape or pose");
         // Held at its own end pose, as the replay holds it: the least-squares multipliers then
         // include the end's reactions, and they warm-start the replay's first solve row for row.
@@ -189,7 +191,7 @@ fn end_shape(
         return Err(Error::invalid(
             &case.path,
             format!("plan.{field}"),
-            if end.position.is_empty() && end.angles.is_empty() {
+            if !end.is_pose() {
                 format!(
                     "the given shape violates the case's constraints or obstacles by {:.3e} (units of L)",
                     sol.max_violation
@@ -264,10 +266,11 @@ impl Planner {
                 .map_err(|m| Error::invalid(&case.path, format!("plan.{field}"), m))
         };
         let mut options = options;
-        resolve(&mut options.start, "start", held_frame(case).0)?;
-        let start = end_shape(case, "start", &options.start, &static_options)?;
+        let held = held_frame(case);
+        resolve(&mut options.start, "start", held.0)?;
+        let start = end_shape(case, "start", &options.start, held, &static_options)?;
         resolve(&mut options.goal, "goal", model.angles_at(&start.a, 1.0))?;
-        let goal = end_shape(case, "goal", &options.goal, &static_options)?;
+        let goal = end_shape(case, "goal", &options.goal, held, &static_options)?;
         let (linear_rows, _) = classify(&case.problem, 0.0);
         Ok(Planner {
             base: case.problem.clone(),

@@ -72,13 +72,11 @@ impl Verification {
     }
 }
 
-/// A shape's points in case units (from its dimensionless `positions`) and, per obstacle, every
-/// point's surface gap `d − r`.
-fn gaps_at(
-    fine: &Model,
-    obstacles: &[Arc<Obstacle>],
-    positions: &[[f64; 3]],
-) -> (Vec<[f64; 3]>, Vec<Vec<f64>>) {
+/// A shape's points in case units and, per obstacle, every point's surface gap `d − r`.
+type ShapeGaps = (Vec<[f64; 3]>, Vec<Vec<f64>>);
+
+/// [`ShapeGaps`] of the shape with dimensionless boundary `positions`.
+fn gaps_at(fine: &Model, obstacles: &[Arc<Obstacle>], positions: &[[f64; 3]]) -> ShapeGaps {
     let (l, r) = (fine.rod.length, fine.rod.radius);
     let pts: Vec<[f64; 3]> = positions.iter().map(|p| p.map(|v| v * l)).collect();
     let gaps = obstacles
@@ -107,7 +105,7 @@ fn record(fine: &Model, gaps: &[Vec<f64>], k: f64, worst: &mut [ObstacleClearanc
 
 /// The smallest chord bound `(g(p) + g(q) − |q − p|)/2` of any point and obstacle between two
 /// shapes (case units).
-fn chord_bound(a: &(Vec<[f64; 3]>, Vec<Vec<f64>>), b: &(Vec<[f64; 3]>, Vec<Vec<f64>>)) -> f64 {
+fn chord_bound(a: &ShapeGaps, b: &ShapeGaps) -> f64 {
     let mut lo = f64::INFINITY;
     for (ga, gb) in a.1.iter().zip(&b.1) {
         for j in 0..a.0.len() {
@@ -127,8 +125,8 @@ fn between(
     path: &DeformationPath,
     z: &[f64],
     obstacles: &[Arc<Obstacle>],
-    lo: (f64, &(Vec<[f64; 3]>, Vec<Vec<f64>>)),
-    hi: (f64, &(Vec<[f64; 3]>, Vec<Vec<f64>>)),
+    lo: (f64, &ShapeGaps),
+    hi: (f64, &ShapeGaps),
     depth: usize,
     worst: &mut [ObstacleClearance],
 ) {
@@ -203,14 +201,16 @@ pub fn verify_with(
         .collect();
     // Each grid shape's positions (case units) and, per obstacle, every point's surface gap,
     // for the check between grid values below.
-    let mut grid: Vec<(Vec<[f64; 3]>, Vec<Vec<f64>>)> = Vec::with_capacity(k_samples);
+    let mut grid: Vec<ShapeGaps> = Vec::with_capacity(k_samples);
     for &k in &ks {
         path.shape_at(z, k, &mut a);
         fine.evaluate_into(&a, &mut shape);
         let t = fine.energy(&a, &shape, objective, None);
         energies.push(unit * t.value(objective));
         if !obstacles.is_empty() {
-            grid.push(gaps_at(fine, obstacles, &shape.positions));
+            let g = gaps_at(fine, obstacles, &shape.positions);
+            record(fine, &g.1, k, &mut worst);
+            grid.push(g);
         }
         for &(i, j) in &pairs {
             let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
@@ -219,9 +219,6 @@ pub fn verify_with(
             if worst_self.is_none_or(|(g, _)| gap < g) {
                 worst_self = Some((gap, k));
             }
-        }
-        if let Some((_, gaps)) = grid.last() {
-            record(fine, gaps, k, &mut worst);
         }
     }
     // Between grid values: a point moving from p to q keeps at least (g(p) + g(q) − |q − p|)/2

@@ -90,7 +90,6 @@ pub fn run(
     // Ctrl-C reaches every case's process, which finishes its own log and exits with 130; this
     // process waits for them and reports.
     let _ = ctrlc::set_handler(|| {});
-    let mut outcomes: Vec<Option<Outcome>> = (0..cases.len()).map(|_| None).collect();
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|scope| {
@@ -113,15 +112,15 @@ pub fn run(
             });
         }
     });
-    for (i, o) in results.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        outcomes[i] = Some(o);
-    }
-    let outcomes: Vec<Outcome> = outcomes.into_iter().flatten().collect();
+    // In the order the cases were given.
+    let mut results = results.into_inner().unwrap_or_else(|p| p.into_inner());
+    results.sort_by_key(|(i, _)| *i);
+    let outcomes: Vec<Outcome> = results.into_iter().map(|(_, o)| o).collect();
     let code = outcomes.iter().fold(0, |acc, o| worst(acc, o.code));
     let text = if json {
         json_lines(&outcomes)
     } else {
-        table(command, &outcomes)
+        table(command, &outcomes, code)
     };
     super::emit(&text);
     ExitCode::from(code)
@@ -179,8 +178,9 @@ fn num(v: &serde_json::Value, path: &[&str]) -> Option<f64> {
     path.iter().try_fold(v, |v, k| v.get(k))?.as_f64()
 }
 
-/// The summary table: one row per case with what decides it.
-fn table(command: &str, outcomes: &[Outcome]) -> String {
+/// The summary table: one row per case with what decides it, and the batch's exit code
+/// `worst_code`.
+fn table(command: &str, outcomes: &[Outcome], worst_code: u8) -> String {
     use std::fmt::Write;
     let mut o = String::new();
     let head = match command {
@@ -246,7 +246,6 @@ fn table(command: &str, outcomes: &[Outcome]) -> String {
             r.seconds
         );
     }
-    let worst_code = outcomes.iter().fold(0, |acc, r| worst(acc, r.code));
     let ok = outcomes.iter().filter(|r| r.code == 0).count();
     let _ = writeln!(
         o,

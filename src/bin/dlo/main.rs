@@ -577,10 +577,11 @@ fn speed_limits(v: Option<f64>, w: Option<f64>) -> Result<Option<[f64; 2]>, Exit
     Ok(Some([v, w]))
 }
 
-/// Writes `text` to `path` through a temporary file moved into place, so that a failed write
-/// leaves no half-written file (and an earlier run's file stays whole until the new one is).
+/// Writes `text` to `path` through a temporary file ([`partial_path`], as the log) moved into
+/// place, so that a failed write leaves no half-written file (and an earlier run's file stays
+/// whole until the new one is).
 fn write_atomically(path: &Path, text: &str) -> Result<(), ExitCode> {
-    let tmp = path.with_extension("partial");
+    let tmp = partial_path(path);
     let written = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
     written.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
