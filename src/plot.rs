@@ -175,19 +175,14 @@ fn obstacle_triangles(up: &SceneUpdate) -> Vec<[[f64; 3]; 3]> {
 
 /// Reads what can be drawn from the bytes of a `dlo plan`, `shape` or `margin` log.
 pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
-    crate::mcap_log::writer::check_magic(bytes)?;
-    let stream = mcap::MessageStream::new_with_options(
-        bytes,
-        enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),
-    )?;
     let mut shapes: BTreeMap<(&'static str, u64), Vec<[f64; 3]>> = BTreeMap::new();
     let mut energy: BTreeMap<(&'static str, u64), (f64, f64)> = BTreeMap::new();
     let mut out = PlanFrames::default();
     let decode = |m: &mcap::Message| {
         SceneUpdate::decode(&m.data[..]).map_err(|_| PlotError::Decode(m.channel.topic.clone()))
     };
-    for m in stream {
-        let Ok(m) = m else { break };
+    // A broken file is drawn as far as it can be read.
+    crate::mcap_log::reader::for_each_readable(bytes, |m| -> Result<(), PlotError> {
         let topic = m.channel.topic.as_str();
         match topic {
             "/rod/optimal" | "/rod/feasible" | "/grasp/held_shape" => {
@@ -196,7 +191,7 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
                     "/rod/feasible" => "feasible",
                     _ => "held",
                 };
-                shapes.insert((which, m.log_time), line_points(&decode(&m)?));
+                shapes.insert((which, m.log_time), line_points(&decode(m)?));
             }
             "/metrics/optimal" | "/metrics/feasible" | "/metrics/straight" => {
                 let v: serde_json::Value = serde_json::from_slice(&m.data)
@@ -213,7 +208,7 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
                 }
             }
             "/rod/endpoints" => {
-                let up = decode(&m)?;
+                let up = decode(m)?;
                 let pts = line_points(&up);
                 match up.entities.first().map(|e| e.id.as_str()) {
                     Some("goal") => out.goal = Some(pts),
@@ -221,10 +216,10 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
                     _ => out.goal = Some(pts),
                 }
             }
-            "/rod/shape" => out.shape = Some(line_points(&decode(&m)?)),
-            "/scene/obstacles" => out.obstacles = obstacle_triangles(&decode(&m)?),
+            "/rod/shape" => out.shape = Some(line_points(&decode(m)?)),
+            "/scene/obstacles" => out.obstacles = obstacle_triangles(&decode(m)?),
             "/grasp/fingers" => {
-                for e in decode(&m)?.entities {
+                for e in decode(m)?.entities {
                     for a in &e.arrows {
                         // The arrow ends at the contact, pointing the way the finger pushes.
                         let (t, r) = pose_parts(&a.pose);
@@ -236,7 +231,8 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
             }
             _ => {}
         }
-    }
+        Ok(())
+    })?;
     let held_count = shapes.keys().filter(|(w, _)| *w == "held").count();
     for ((which, t), points) in shapes {
         let (k, u) = energy

@@ -37,6 +37,9 @@ pub struct Inspection {
     pub indexed: bool,
     /// Where a streaming read stopped early, if it did.
     pub stopped_at: Option<String>,
+    /// The first problem a check of the whole file finds (a bad CRC, a torn or missing
+    /// summary, bytes after the end), or `None` for a finished, undamaged file.
+    pub damage: Option<String>,
 }
 
 /// Reads every message of `bytes`.
@@ -44,7 +47,7 @@ pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
     let mut topics: BTreeMap<String, TopicSummary> = BTreeMap::new();
     let mut messages = 0;
     let (mut start, mut end): (Option<u64>, Option<u64>) = (None, None);
-    let stopped_at = super::writer::for_each_readable(bytes, |m| {
+    let stopped_at = super::reader::for_each_readable(bytes, |m| -> Result<(), LogError> {
         let t = topics
             .entry(m.channel.topic.clone())
             .or_insert_with(|| TopicSummary {
@@ -75,5 +78,6 @@ pub fn inspect(bytes: &[u8]) -> Result<Inspection, LogError> {
         end_time: end,
         indexed: matches!(mcap::Summary::read(bytes), Ok(Some(_))),
         stopped_at,
+        damage: super::reader::check_finished(bytes).err(),
     })
 }

@@ -1,9 +1,10 @@
 //! MCAP logs for Foxglove: a streaming writer ([`writer`]), Foxglove scene messages
 //! ([`scene`]), the planner's observer ([`plan_log`]), and tools for finished or broken files
-//! ([`inspect`], [`recover`]).
+//! ([`reader`], [`inspect`], [`recover`]).
 
 pub mod inspect;
 pub mod plan_log;
+pub mod reader;
 pub mod recover;
 pub mod scene;
 pub mod writer;

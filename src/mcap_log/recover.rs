@@ -11,21 +11,25 @@ use std::io::{Seek, Write};
 pub struct Recovery {
     /// Messages copied.
     pub messages: u64,
-    /// Whether the input ended early (a torn record or a missing summary/footer).
+    /// Whether the input was anything but a finished, undamaged file (a torn or corrupted
+    /// record, a missing or damaged summary or footer).
     pub truncated: bool,
     /// The reader's complaint at the point it stopped, if any.
     pub stopped_at: Option<String>,
+    /// The first problem a check of the whole input finds, if any (see
+    /// [`super::reader::check_finished`]).
+    pub damage: Option<String>,
 }
 
 /// Copies every readable message of `input` (the bytes of an MCAP file, complete or not) to a
 /// new, finished MCAP written on `out`.
 pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogError> {
-    super::writer::check_magic(input)?;
+    super::reader::check_magic(input)?;
     let mut w = super::writer::write_options().create(out)?;
     let mut channels: HashMap<u16, u16> = HashMap::new();
     let mut schemas: HashMap<u16, u16> = HashMap::new();
     let mut messages = 0;
-    let stopped_at = super::writer::for_each_readable(input, |m| {
+    let stopped_at = super::reader::for_each_readable(input, |m| -> Result<(), LogError> {
         let ch = &m.channel;
         let id = match channels.get(&ch.id) {
             Some(&id) => id,
@@ -59,11 +63,11 @@ pub fn recover<W: Write + Seek>(input: &[u8], out: W) -> Result<Recovery, LogErr
         Ok(())
     })?;
     w.finish()?;
-    let complete =
-        mcap::read::footer(input).is_ok() && matches!(mcap::Summary::read(input), Ok(Some(_)));
+    let damage = super::reader::check_finished(input).err();
     Ok(Recovery {
         messages,
-        truncated: stopped_at.is_some() || !complete,
+        truncated: stopped_at.is_some() || damage.is_some(),
         stopped_at,
+        damage,
     })
 }

@@ -21,35 +21,6 @@ pub fn write_options() -> mcap::WriteOptions {
         .profile("")
 }
 
-/// Fails unless `bytes` starts with the MCAP magic.
-pub fn check_magic(bytes: &[u8]) -> Result<(), LogError> {
-    if bytes.starts_with(mcap::MAGIC) {
-        Ok(())
-    } else {
-        Err(mcap::McapError::BadMagic)
-    }
-}
-
-/// Calls `f` on every message a streaming reader reaches in `bytes` (a finished or a broken
-/// MCAP file); returns where the read stopped early, if it did.
-pub fn for_each_readable(
-    bytes: &[u8],
-    mut f: impl FnMut(&mcap::Message) -> Result<(), LogError>,
-) -> Result<Option<String>, LogError> {
-    check_magic(bytes)?;
-    let stream = mcap::MessageStream::new_with_options(
-        bytes,
-        enumset::enum_set!(mcap::read::Options::IgnoreEndMagic),
-    )?;
-    for m in stream {
-        match m {
-            Ok(m) => f(&m)?,
-            Err(e) => return Ok(Some(e.to_string())),
-        }
-    }
-    Ok(None)
-}
-
 /// The writer behind every log.
 pub struct McapWriter<W: Write + Seek> {
     inner: Option<mcap::Writer<W>>,

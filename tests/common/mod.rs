@@ -175,3 +175,13 @@ pub fn strip(v: &mut serde_json::Value) {
         _ => {}
     }
 }
+
+/// Seconds each generated-input test file runs for: `DLO_FUZZ_SECONDS`, or 8 (`.ci/run` sets
+/// more).
+pub fn fuzz_seconds() -> f64 {
+    std::env::var("DLO_FUZZ_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|s: &f64| s.is_finite() && *s >= 0.0)
+        .unwrap_or(8.0)
+}

@@ -911,10 +911,11 @@ fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
                 r.messages,
                 broken.display(),
                 fixed.display(),
-                match (&r.truncated, &r.stopped_at) {
-                    (true, Some(s)) => format!(" (the input was cut short: {s})"),
-                    (true, None) => " (the input had no summary)".into(),
-                    _ => " (the input was complete)".into(),
+                match (&r.stopped_at, &r.damage) {
+                    (Some(s), _) => format!(" (the input was cut short: {s})"),
+                    (None, Some(d)) =>
+                        format!(" (every message was read; the input is damaged: {d})"),
+                    (None, None) => " (the input was complete)".into(),
                 }
             ));
             ExitCode::SUCCESS
@@ -980,6 +981,8 @@ fn run_inspect(file: &Path, json: bool) -> ExitCode {
     }
     if let Some(s) = &ins.stopped_at {
         let _ = writeln!(o, "  the file ends early: {s}");
+    } else if let Some(d) = &ins.damage {
+        let _ = writeln!(o, "  every message was read, but the file is damaged: {d}");
     }
     emit(&o);
     ExitCode::SUCCESS
