@@ -11,7 +11,7 @@ use crate::constraints::{
 use crate::error::Error;
 use crate::layout::{Field, Layout};
 use crate::model::{Discretisation, Model, PointLoad};
-use crate::obstacle::{Obstacle, ObstacleShape, read_obj};
+use crate::obstacle::{Obstacle, ObstacleShape};
 use crate::optim::AlOptions;
 use crate::problem::StaticProblem;
 use crate::rod::{Profile, Rod};
@@ -1006,15 +1006,25 @@ fn build_shape(
                     format!("cannot read {}: {e}", full.display()),
                 )
             })?;
-            let (verts, faces) = read_obj(&text)
+            let obj = crate::mesh::parse_obj(&text)
                 .map_err(|e| v.err(format!("{field}.obj"), format!("{}: {e}", full.display())))?;
-            if verts.is_empty() || faces.is_empty() {
-                return Err(v.err(
-                    format!("{field}.obj"),
-                    format!("{}: the mesh has no triangles", full.display()),
-                ));
-            }
-            let verts: Vec<Vector> = verts.iter().map(|p| vv(p.map(|c| c * sc))).collect();
+            let verts: Vec<[f64; 3]> = obj.vertices.iter().map(|p| p.map(|c| c * sc)).collect();
+            crate::mesh::check_solid(&verts, &obj.triangles).map_err(|d| {
+                let what = d.describe(|t| format!("line {}", obj.lines[t]));
+                match d {
+                    crate::mesh::MeshDefect::NotFinite { .. }
+                    | crate::mesh::MeshDefect::TooLarge => v.err(
+                        format!("{field}.scale"),
+                        format!("{}: {what}", full.display()),
+                    ),
+                    _ => v.err(
+                        format!("{field}.obj"),
+                        format!("{}: {what}", full.display()),
+                    ),
+                }
+            })?;
+            let (verts, faces): (Vec<Vector>, _) =
+                (verts.iter().map(|p| vv(*p)).collect(), obj.triangles);
             let mesh = TriMesh::with_flags(
                 verts,
                 faces,

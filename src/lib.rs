@@ -25,6 +25,7 @@ pub mod hessian;
 pub mod kinematics;
 pub mod layout;
 pub mod mcap_log;
+pub mod mesh;
 pub mod model;
 pub mod obstacle;
 pub mod optim;

@@ -4,7 +4,8 @@
 //! parry's `distance` is 0 once shapes touch and has no gradient inside, so the signed distance
 //! uses point projection with the inside flag. Half-spaces are evaluated analytically (parry's
 //! contact query mishandles a half-space as second shape). A triangle mesh must be closed and
-//! consistently oriented (built with `ORIENTED`) for inside points to be recognised.
+//! consistently oriented (built with `ORIENTED`) for inside points to be recognised;
+//! [`crate::mesh::check_solid`] checks that.
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::PointQuery;
@@ -214,57 +215,6 @@ fn project_cuboid(h: Vector, pt: Vector) -> parry3d_f64::query::PointProjection 
         Vector::new(0.0, 0.0, diff.z * sgn.z)
     };
     parry3d_f64::query::PointProjection::new(true, pt + shift)
-}
-
-/// Vertices and triangles of a mesh.
-pub type MeshData = (Vec<[f64; 3]>, Vec<[u32; 3]>);
-
-/// Reads a Wavefront OBJ file's `v` and `f` records (faces are triangulated as fans; texture and
-/// normal indices are ignored).
-pub fn read_obj(text: &str) -> Result<MeshData, String> {
-    let mut verts = Vec::new();
-    let mut faces = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Result<Vec<f64>, _> = it.take(3).map(str::parse::<f64>).collect();
-                match c {
-                    Ok(c) if c.len() == 3 && c.iter().all(|v| v.is_finite()) => {
-                        verts.push([c[0], c[1], c[2]])
-                    }
-                    _ => return Err(format!("line {}: bad vertex", ln + 1)),
-                }
-            }
-            Some("f") => {
-                let idx: Result<Vec<u32>, String> = it
-                    .map(|tok| {
-                        let i: i64 = tok
-                            .split('/')
-                            .next()
-                            .unwrap_or("")
-                            .parse()
-                            .map_err(|_| format!("line {}: bad face index '{tok}'", ln + 1))?;
-                        let n = verts.len() as i64;
-                        let k = if i < 0 { n + i } else { i - 1 };
-                        if k < 0 || k >= n {
-                            return Err(format!("line {}: face index {i} out of range", ln + 1));
-                        }
-                        Ok(k as u32)
-                    })
-                    .collect();
-                let idx = idx?;
-                if idx.len() < 3 {
-                    return Err(format!("line {}: face with fewer than 3 vertices", ln + 1));
-                }
-                for k in 1..idx.len() - 1 {
-                    faces.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok((verts, faces))
 }
 
 #[cfg(test)]

@@ -798,3 +798,110 @@ fn hostile_inputs_and_outputs_fail_cleanly() {
     let (code, _, err) = run(&["recover", fixed.to_str().unwrap(), fixed.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
 }
+
+/// Meshes that bound no solid are rejected naming the mesh, the field and the defect, in
+/// `dlo shape` and in `dlo plan` (where a flat or inside-out mesh once surfaced as "no static
+/// shape reaches this pose"); a mesh written with per-face vertex copies is accepted.
+#[test]
+fn meshes_that_bound_no_solid_are_rejected() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-meshes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let cube = std::fs::read_to_string(format!("{root}/planning_cases/meshes/cube.obj")).unwrap();
+    let verts: Vec<&str> = cube.lines().filter(|l| l.starts_with("v ")).collect();
+    let faces: Vec<&str> = cube.lines().filter(|l| l.starts_with("f ")).collect();
+    let obj = |fs: &[String]| format!("{}\n{}\n", verts.join("\n"), fs.join("\n"));
+    let flip = |f: &str| {
+        let i: Vec<&str> = f.split_whitespace().collect();
+        format!("f {} {} {}", i[1], i[3], i[2])
+    };
+    let all: Vec<String> = faces.iter().map(|f| f.to_string()).collect();
+    let flat_verts: Vec<String> = verts
+        .iter()
+        .map(|v| {
+            let c: Vec<&str> = v.split_whitespace().collect();
+            format!("v {} {} 0", c[1], c[2])
+        })
+        .collect();
+    // Per-face copies of the vertices (as exporters write them): the same solid.
+    let mut copies = String::new();
+    for (k, f) in faces.iter().enumerate() {
+        for i in f.split_whitespace().skip(1) {
+            copies += verts[i.parse::<usize>().unwrap() - 1];
+            copies += "\n";
+        }
+        copies += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    let meshes = [
+        ("open", obj(&all[..all.len() - 1]), "not closed"),
+        (
+            "inside_out",
+            obj(&faces.iter().map(|f| flip(f)).collect::<Vec<_>>()),
+            "inside-out",
+        ),
+        (
+            "one_flipped",
+            obj(&[&[flip(faces[0])], &all[1..]].concat()),
+            "wound the same way",
+        ),
+        (
+            "doubled",
+            obj(&[&all[..], &all[..1]].concat()),
+            "more than two triangles",
+        ),
+        (
+            "flattened",
+            format!("{}\n{}\n", flat_verts.join("\n"), all.join("\n")),
+            "more than two triangles",
+        ),
+        // A two-sided triangle: closed and consistent, but it encloses nothing.
+        (
+            "flat",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 3 2\n".to_string(),
+            "no volume",
+        ),
+        (
+            "sliver",
+            obj(&[&all[..], &["f 1 1 2".to_string()]].concat()),
+            "zero area",
+        ),
+    ];
+    let plan = std::fs::read_to_string(format!("{root}/planning_cases/plan_cable_past_mesh.json"))
+        .unwrap();
+    for (name, text, needle) in &meshes {
+        std::fs::write(dir.join(format!("{name}.obj")), text).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&plan).unwrap();
+        v["obstacles"][0]["shape"]["obj"] = format!("{name}.obj").into();
+        v["name"] = format!("mesh_{name}").into();
+        let p = dir.join(format!("mesh_{name}.json"));
+        std::fs::write(&p, v.to_string()).unwrap();
+        for cmd in ["shape", "plan"] {
+            let (code, out, err) =
+                run(&[cmd, p.to_str().unwrap(), "--log-dir", dir.to_str().unwrap()]);
+            assert_eq!(code, 2, "{name} ({cmd}): {err}");
+            assert!(
+                err.contains(&format!("{name}.obj"))
+                    && err.contains("obstacles[0].shape.obj")
+                    && err.contains(needle),
+                "{name} ({cmd}): {err}"
+            );
+            assert!(
+                out.is_empty() && !err.contains("panicked"),
+                "{name}: {out}{err}"
+            );
+        }
+    }
+    std::fs::write(dir.join("copies.obj"), copies).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&plan).unwrap();
+    v["obstacles"][0]["shape"]["obj"] = "copies.obj".into();
+    let p = dir.join("mesh_copies.json");
+    std::fs::write(&p, v.to_string()).unwrap();
+    let (code, _, err) = run(&[
+        "shape",
+        p.to_str().unwrap(),
+        "--log-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "per-face vertex copies: {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
