@@ -64,6 +64,27 @@ impl StaticProblem {
     pub fn shape(&self) -> &Shape {
         &self.shape
     }
+
+    /// The constraint block violated most at `a` (label and violation in units of L), if any
+    /// is violated by more than `tol`: what keeps a failed solve from its target.
+    pub fn most_violated(&mut self, a: &[f64], tol: f64) -> Option<(String, f64)> {
+        let mut c = vec![0.0; self.m()];
+        self.values(a, &mut c);
+        (0..self.constraints.len())
+            .map(|k| {
+                let worst = self
+                    .rows_of(k)
+                    .map(|i| match self.senses[i] {
+                        Sense::Equal => c[i].abs(),
+                        Sense::LessEq => c[i].max(0.0),
+                    })
+                    .fold(0.0, f64::max);
+                (k, worst)
+            })
+            .filter(|&(_, w)| w > tol)
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+            .map(|(k, w)| (self.constraints[k].label(), w))
+    }
 }
 
 impl Nlp for StaticProblem {

@@ -905,3 +905,179 @@ fn meshes_that_bound_no_solid_are_rejected() {
     assert_eq!(code, 0, "per-face vertex copies: {err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Sizes and magnitudes that would make a run take unbounded time or overflow its arithmetic are
+/// refused before any work starts (exit 2, naming the field); duplicate keys inside `plan` and
+/// `grasp` are refused like those at the top level; names that cannot name a file are refused
+/// at validation; suspicious but legal values run with a warning; an end placed inside an
+/// obstacle names the obstacle.
+#[test]
+fn limits_warnings_and_blocked_poses_are_reported_before_work() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-limits-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let read = |n: &str| -> serde_json::Value {
+        serde_json::from_str(
+            &std::fs::read_to_string(format!("{root}/planning_cases/{n}")).unwrap(),
+        )
+        .unwrap()
+    };
+    let write = |name: &str, v: &serde_json::Value| {
+        let p = dir.join(format!("{name}.json"));
+        std::fs::write(&p, v.to_string()).unwrap();
+        p
+    };
+    let logs = dir.join("logs");
+    let logs = logs.to_str().unwrap();
+    let set = |base: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = read(base);
+        edit(&mut v);
+        v
+    };
+    let pinned = "pinned_buckling_080.json";
+    let refused: Vec<(&str, &str, serde_json::Value, &str)> = vec![
+        (
+            "nodes",
+            "shape",
+            set(pinned, &|v| {
+                v["discretisation"] = serde_json::json!({"panels": 2000, "gauss_points": 16})
+            }),
+            "discretisation.panels",
+        ),
+        (
+            "self_contact_samples",
+            "shape",
+            set("self_contact_crossed_loop.json", &|v| {
+                v["discretisation"]["samples"] = 2000.into()
+            }),
+            "discretisation.samples",
+        ),
+        (
+            "rigidity",
+            "shape",
+            set(pinned, &|v| v["rod"]["flexural_rigidity"] = 1e300.into()),
+            "rod.flexural_rigidity",
+        ),
+        (
+            "coefficients",
+            "shape",
+            set(
+                pinned,
+                &|v| v["shape"] = serde_json::json!({"theta": [1e300, 0, 0, 0, 0, 0, 0, 0, 0, 0]}),
+            ),
+            "shape.theta[0]",
+        ),
+        (
+            "report_points",
+            "shape",
+            set(pinned, &|v| v["report_points"] = vec![0.5; 3000].into()),
+            "report_points",
+        ),
+        (
+            "outer",
+            "shape",
+            set(pinned, &|v| {
+                v["solver"] = serde_json::json!({"max_outer": 1000000})
+            }),
+            "solver.max_outer",
+        ),
+        (
+            "long_name",
+            "shape",
+            set(pinned, &|v| v["name"] = "n".repeat(300).into()),
+            "name",
+        ),
+        (
+            "nul_name",
+            "shape",
+            set(pinned, &|v| v["name"] = "a\u{0}b".into()),
+            "name",
+        ),
+        (
+            "safety",
+            "plan",
+            set("plan_paper_planar.json", &|v| {
+                v["plan"]["safety_margin"] = 1.0.into()
+            }),
+            "plan.safety_margin",
+        ),
+        (
+            "verify_grid",
+            "plan",
+            set("plan_paper_planar.json", &|v| {
+                v["plan"]["verify_k_samples"] = 100001.into();
+                v["plan"]["verify_s_samples"] = 10000.into();
+            }),
+            "plan.verify_k_samples",
+        ),
+        (
+            "directions",
+            "margin",
+            set("grasp_a_080.json", &|v| {
+                v["grasp"]["directions"] = vec![serde_json::json!([1.0, 0.0]); 1000].into()
+            }),
+            "grasp.directions",
+        ),
+        (
+            "limits",
+            "margin",
+            set("grasp_a_080.json", &|v| {
+                v["grasp"]["points"] = (1..5000)
+                    .map(|i| i as f64 / 5000.0 * 100.0)
+                    .collect::<Vec<_>>()
+                    .into();
+                v["grasp"]["directions"] = 360.into();
+            }),
+            "grasp.points",
+        ),
+    ];
+    for (name, cmd, v, field) in &refused {
+        let p = write(name, v);
+        let (code, out, err) = run(&[cmd, p.to_str().unwrap(), "--log-dir", logs]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(field) && err.contains(&format!("{name}.json")),
+            "{name}: {err}"
+        );
+        assert!(
+            out.is_empty() && !err.contains("panicked"),
+            "{name}: {out}{err}"
+        );
+    }
+    // Duplicate keys inside sections kept as JSON values.
+    let paper =
+        std::fs::read_to_string(format!("{root}/planning_cases/plan_paper_planar.json")).unwrap();
+    let dup = paper.replacen("\"plan\": {", "\"plan\": {\"starts\": 1, \"starts\": 2,", 1);
+    assert_ne!(dup, paper);
+    let p = dir.join("dup.json");
+    std::fs::write(&p, dup).unwrap();
+    let (code, _, err) = run(&["plan", p.to_str().unwrap(), "--log-dir", logs]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("duplicate field `starts`"), "{err}");
+    // Degrees where radians are meant: a warning that says what was assumed, then the run.
+    let p = write(
+        "degrees",
+        &set("plan_paper_planar.json", &|v| {
+            v["plan"]["goal"]["theta"] = 90.0.into()
+        }),
+    );
+    let (_, _, err) = run(&["plan", p.to_str().unwrap(), "--log-dir", logs]);
+    assert!(
+        err.contains("warning") && err.contains("plan.goal.theta") && err.contains("1.570796"),
+        "{err}"
+    );
+    // An end inside the paper case's block names the block.
+    let p = write(
+        "inside",
+        &set("plan_paper_planar.json", &|v| {
+            v["plan"]["goal"] = serde_json::json!({"x": 0.0, "z": 0.9, "theta": 0.0})
+        }),
+    );
+    let (code, _, err) = run(&["plan", p.to_str().unwrap(), "--log-dir", logs]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("plan.goal") && err.contains("inside obstacle 'block'"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

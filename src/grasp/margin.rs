@@ -146,6 +146,8 @@ impl Grasp {
 
     /// Validates the `grasp` section and solves the undisturbed grasp.
     pub fn from_case(case: &Case) -> Result<Grasp, Error> {
+        /// The most force limits one margin computes (points × directions).
+        const MAX_LIMITS: usize = 10_000;
         let path = &case.path;
         let err = |f: &str, m: String| Error::invalid(path, f, m);
         let spec: GraspSpec = match &case.grasp {
@@ -236,6 +238,12 @@ impl Grasp {
                 even_directions(k as usize)
             }
             Some(serde_json::Value::Array(list)) => {
+                if list.len() > 360 {
+                    return Err(err(
+                        "grasp.directions",
+                        format!("a list holds at most 360 directions, got {}", list.len()),
+                    ));
+                }
                 let mut out = Vec::new();
                 for (i, d) in list.iter().enumerate() {
                     let f = format!("grasp.directions[{i}]");
@@ -280,6 +288,18 @@ impl Grasp {
                 ));
             }
         };
+        // Each (point, direction) pair is a continuation of about 16 solves.
+        if points.len() * directions.len() > MAX_LIMITS {
+            return Err(err(
+                "grasp.points",
+                format!(
+                    "{} points × {} directions = {} force limits; at most {MAX_LIMITS}",
+                    points.len(),
+                    directions.len(),
+                    points.len() * directions.len()
+                ),
+            ));
+        }
         let mu = spec
             .mu
             .clone()

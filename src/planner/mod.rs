@@ -188,23 +188,58 @@ fn end_shape(
         solve_static(&mut pose.problem(base), &a0, opts)
     };
     if sol.status != SolveStatus::Converged {
-        return Err(Error::invalid(
-            &case.path,
-            format!("plan.{field}"),
-            if !end.is_pose() {
-                format!(
-                    "the given shape violates the case's constraints or obstacles by {:.3e} (units of L)",
-                    sol.max_violation
-                )
-            } else {
-                format!(
-                    "no static shape reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L)",
-                    sol.status, sol.max_violation
-                )
-            },
-        ));
+        let msg = if !end.is_pose() {
+            format!(
+                "the given shape violates the case's constraints or obstacles by {:.3e} (units of L)",
+                sol.max_violation
+            )
+        } else if let Some(inside) = end_inside_obstacle(case, end) {
+            inside
+        } else {
+            let blocking = pose
+                .problem(base)
+                .most_violated(&sol.a, opts.al.feasibility_tol)
+                .map_or(String::new(), |(label, w)| {
+                    format!("; the most violated constraint is {label} (by {w:.3e} L)")
+                });
+            format!(
+                "no static shape reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L){blocking}",
+                sol.status, sol.max_violation
+            )
+        };
+        return Err(Error::invalid(&case.path, format!("plan.{field}"), msg));
     }
     Ok(sol)
+}
+
+/// Whether the end's position (when every component is given) lies inside an obstacle or
+/// closer to it than the rod's radius and the obstacle's margin allow; says which.
+fn end_inside_obstacle(case: &Case, end: &End) -> Option<String> {
+    let model = &case.problem.model;
+    let l = model.rod.length;
+    let comps = if model.layout.spatial { 3 } else { 2 };
+    if end.position.len() < comps {
+        return None;
+    }
+    let mut p = [0.0; 3];
+    for &(k, x) in &end.position {
+        p[k] = x * l;
+    }
+    case.problem.constraints.iter().find_map(|c| {
+        let oc = c
+            .as_any()
+            .downcast_ref::<crate::constraints::ObstacleConstraint>()?;
+        let d = oc.obstacle.signed_distance_value(p);
+        let need = oc.clearance * l;
+        (d < need).then(|| {
+            format!(
+                "the end position {p:?} lies {} obstacle '{}' (signed distance {d:.4e}, the rod \
+                 needs {need:.4e}: its radius plus the obstacle's margin)",
+                if d < 0.0 { "inside" } else { "too close to" },
+                oc.obstacle.name
+            )
+        })
+    })
 }
 
 /// All three Euler angles of an end, when its pose gives them.

@@ -569,9 +569,30 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
             ),
         ));
     }
+    // Grid points of one verification pass.
+    let grid = spec.verify_k_samples.saturating_mul(spec.verify_s_samples);
+    if grid > 10_000_000 {
+        return Err(v.err(
+            "plan.verify_k_samples",
+            format!("verify_k_samples × verify_s_samples = {grid}; at most 1e7"),
+        ));
+    }
+    if spec.sharpness.len() > 50 || spec.fallback_path_terms.len() > 8 {
+        return Err(v.err(
+            if spec.sharpness.len() > 50 {
+                "plan.sharpness"
+            } else {
+                "plan.fallback_path_terms"
+            },
+            "at most 50 sharpness stages and 8 fallback path-term counts",
+        ));
+    }
     let safety = spec.safety_margin.unwrap_or(l / 100.0);
-    if v.finite("plan.safety_margin", safety)? < 0.0 {
-        return Err(v.err("plan.safety_margin", "must be non-negative"));
+    if !(0.0..=0.25 * l).contains(&v.finite("plan.safety_margin", safety)?) {
+        return Err(v.err(
+            "plan.safety_margin",
+            format!("must be in [0, L/4] = [0, {}], got {safety}", 0.25 * l),
+        ));
     }
     if v.finite("plan.mean_weight", spec.mean_weight)? < 0.0 {
         return Err(v.err("plan.mean_weight", "must be non-negative"));

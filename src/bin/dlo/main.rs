@@ -331,10 +331,14 @@ fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
 }
 
 fn load(path: &std::path::Path) -> Result<Case, ExitCode> {
-    case::load(path).map_err(|e| {
+    let case = case::load(path).map_err(|e| {
         eprintln!("error: {e}");
         ExitCode::from(EXIT_BAD_INPUT)
-    })
+    })?;
+    for w in &case.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    Ok(case)
 }
 
 fn run_shape(path: &std::path::Path, json: bool, log_dir: &Path) -> ExitCode {

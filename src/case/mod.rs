@@ -3,6 +3,11 @@
 //! README with its units and default. Lengths, forces and rigidities are in any one consistent
 //! unit system; angles in radians.
 
+mod limits;
+mod strict_json;
+
+pub use limits::*;
+
 use crate::basis::Basis;
 use crate::constraints::{
     Angle, Bound, Constraint, ObstacleConstraint, OrientationConstraint, PositionConstraint,
@@ -64,8 +69,10 @@ pub struct CaseFile {
     #[serde(default)]
     pub solver: SolverSpec,
     /// Path-planning settings (read by `dlo plan`).
+    #[serde(default, deserialize_with = "strict_json::optional")]
     pub plan: Option<serde_json::Value>,
     /// Grasp-stability settings (read by `dlo margin`).
+    #[serde(default, deserialize_with = "strict_json::optional")]
     pub grasp: Option<serde_json::Value>,
 }
 
@@ -373,6 +380,8 @@ pub struct Case {
     pub grasp: Option<serde_json::Value>,
     /// The parsed file.
     pub file: CaseFile,
+    /// Legal but suspicious values, each with what was assumed (the CLI prints them).
+    pub warnings: Vec<String>,
 }
 
 /// The largest case file read (bytes): far above any real case, small enough that a path to
@@ -556,6 +565,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             ));
         }
     }
+    let warnings = limits::check(&file, &v)?;
     let rod = Rod {
         length: l,
         flexural: r.flexural_rigidity,
@@ -938,6 +948,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         plan: file.plan.clone(),
         grasp: file.grasp.clone(),
         file,
+        warnings,
     })
 }
 
