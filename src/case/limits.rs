@@ -199,7 +199,8 @@ fn coefficients(v: &V, shape: &ShapeSpec) -> Result<(), Error> {
     Ok(())
 }
 
-/// Angles (radians) of more than a turn: probably degrees.
+/// Direction angles (radians) of more than a turn: probably degrees. Only `θ` and `φ`, which
+/// place the tangent: twists (`ψ`, `φ + ψ`, `twist`) of several turns are common.
 fn angle_warnings(file: &CaseFile, warnings: &mut Vec<String>) {
     let mut check = |field: String, a: Option<f64>| {
         if let Some(a) = a {
@@ -213,27 +214,15 @@ fn angle_warnings(file: &CaseFile, warnings: &mut Vec<String>) {
         }
     };
     for (i, c) in file.constraints.iter().enumerate() {
-        if let super::ConstraintSpec::Orientation {
-            phi,
-            theta,
-            psi,
-            phi_plus_psi,
-            ..
-        } = c
-        {
-            for (n, a) in [
-                ("phi", phi),
-                ("theta", theta),
-                ("psi", psi),
-                ("phi_plus_psi", phi_plus_psi),
-            ] {
+        if let super::ConstraintSpec::Orientation { phi, theta, .. } = c {
+            for (n, a) in [("phi", phi), ("theta", theta)] {
                 check(format!("constraints[{i}].{n}"), *a);
             }
         }
     }
     if let Some(plan) = &file.plan {
         for end in ["start", "goal"] {
-            for n in ["phi", "theta", "psi", "twist"] {
+            for n in ["phi", "theta"] {
                 check(format!("plan.{end}.{n}"), plan[end][n].as_f64());
             }
         }

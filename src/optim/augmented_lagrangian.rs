@@ -240,7 +240,17 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     on_outer: &mut dyn FnMut(&OuterIterate, &P),
 ) -> AlOutcome {
     let (n, m) = (p.n(), p.m());
-    let mut lambda = lambda0.map_or(vec![0.0; m], |l| l.to_vec());
+    // A run started without multipliers on a stable equilibrium holds on to it.
+    let seeded = lambda0
+        .is_none()
+        .then(|| equilibrium_multipliers(p, x, &opts))
+        .flatten();
+    let on_equilibrium = seeded.is_some();
+    let mut lambda = match (lambda0, seeded) {
+        (Some(l), _) => l.to_vec(),
+        (None, Some(l)) => l,
+        (None, None) => vec![0.0; m],
+    };
     let mut rho = opts.rho_initial;
     let mut c = vec![0.0; m];
     let mut y = vec![0.0; m];
@@ -261,6 +271,8 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
     let mut last_hessian: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
     // The last outer iteration took a second-order multiplier step.
     let mut dual_stepped = false;
+    // Step off saddles of Φ (set once one is found to be the problem's, not the penalty's).
+    let mut escape = false;
     while outer < opts.max_outer {
         outer += 1;
         p.set_multipliers(&lambda);
@@ -303,6 +315,10 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
                     max_iter: opts.max_inner,
                     max_step: opts.max_step,
                     min_iter: usize::from(dual_stepped),
+                    // A negative curvature of Φ at a stationary point may be the penalty's
+                    // (too small to hold the constraints) rather than the problem's: the
+                    // saddle is left only once the reduced Hessian says it is the problem's.
+                    escape_saddles: escape || rho >= opts.rho_max,
                 },
             )
         } else {
@@ -330,6 +346,18 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             )
         };
         inner_iterations += out.iterations;
+        if out.status == BfgsStatus::Saddle {
+            // In a run started on a stable equilibrium, where the problem itself curves up
+            // clearly along the constraints, the negative curvature of Φ is the penalty's (too
+            // small to hold the constraints) and the stationary point stands: the run stays on
+            // the equilibrium it was started on. Otherwise (a saddle of the problem, one it
+            // cannot tell from neutral such as a pitchfork, or a warm-started continuation
+            // step) minimise again from here, stepping off it.
+            if !on_equilibrium || !clearly_stable_along_constraints(p, x, &lambda) {
+                escape = true;
+                continue;
+            }
+        }
         if out.status == BfgsStatus::NumericalFailure {
             status = AlStatus::NumericalFailure;
             break;
@@ -441,6 +469,62 @@ pub fn kkt_residual<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> f64 {
     let mut g = vec![0.0; p.n()];
     p.gradient(x, lambda, &mut g);
     g.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// How close to stationary a feasible start must be for [`equilibrium_multipliers`] to seed
+/// the multipliers: `‖∇f + Jᵀλ‖∞ ≤ NEAR_EQUILIBRIUM · max(1, ‖∇f‖∞)`.
+const NEAR_EQUILIBRIUM: f64 = 1e-2;
+
+/// The multipliers a run starts with when none are given, if `x` is (near) a KKT point: the
+/// least-squares multipliers there, when `x` is feasible and they leave a small residual.
+/// Started from zero multipliers, the first inner minimisation would see a start on an
+/// equilibrium as far from stationary (the reactions it needs are missing) and could leave it
+/// for another branch; with them, Newton's first step stays (or stays near). `None` elsewhere:
+/// a start far from equilibrium keeps zero multipliers.
+fn equilibrium_multipliers<P: Nlp>(p: &mut P, x: &[f64], opts: &AlOptions) -> Option<Vec<f64>> {
+    let m = p.m();
+    if m == 0 {
+        return None;
+    }
+    let mut c = vec![0.0; m];
+    p.values(x, &mut c);
+    if violation(p, &c) > opts.feasibility_tol {
+        return None;
+    }
+    let mut g = vec![0.0; p.n()];
+    p.gradient(x, &vec![0.0; m], &mut g);
+    let scale = inf_norm(&g).max(1.0);
+    let (lam, residual) = least_squares_multipliers_at(p, x, &c, &vec![0.0; m], opts.active_tol)?;
+    if residual > NEAR_EQUILIBRIUM * scale {
+        return None;
+    }
+    // Only a stable (or neutral) equilibrium is held on to: from an unstable one the run sets
+    // out with zero multipliers, as from anywhere else, and falls off it.
+    if unstable_along_constraints(p, x, &lam) {
+        return None;
+    }
+    Some(lam)
+}
+
+/// The reduced Hessian's smallest eigenvalue over its largest magnitude (at least 1) at
+/// `(x, lambda)`: how the Lagrangian curves along the constraints; `None` when they leave no
+/// freedom.
+fn reduced_curvature<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> Option<f64> {
+    let reduced = super::second_order::reduced_hessian_eigenvalues(p, x, lambda, 1e-8);
+    let scale = reduced.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    reduced.first().map(|&l| l / scale)
+}
+
+/// Whether the Lagrangian curves down along the constraints at `(x, lambda)`, beyond the
+/// rounding of an exact Hessian (about 1e-13 of its largest eigenvalue).
+fn unstable_along_constraints<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> bool {
+    reduced_curvature(p, x, lambda).is_some_and(|r| r < -1e-10)
+}
+
+/// Whether it curves up clearly (by more than 1e-6 of its largest eigenvalue) in every
+/// direction the constraints leave free.
+fn clearly_stable_along_constraints<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64]) -> bool {
+    reduced_curvature(p, x, lambda).is_none_or(|r| r > 1e-6)
 }
 
 /// Largest dual Newton step, in first-order steps `ρ‖c_A‖∞`.

@@ -37,6 +37,9 @@ pub enum BfgsStatus {
     LineSearchFailed,
     /// A non-finite value appeared.
     NumericalFailure,
+    /// A stationary point with a clearly negative curvature, left where it is because the
+    /// caller asked not to step off saddles ([`super::newton::NewtonOptions::escape_saddles`]).
+    Saddle,
 }
 
 impl BfgsStatus {

@@ -21,6 +21,9 @@ pub struct NewtonOptions {
     /// Steps taken even when the gradient is already below `grad_tol` (a multiplier update that
     /// moves the minimiser by less than the tolerance still moves it).
     pub min_iter: usize,
+    /// At a stationary point with a clearly negative curvature, step along it while `f` falls
+    /// (else stop there with [`BfgsStatus::Saddle`]).
+    pub escape_saddles: bool,
 }
 
 /// Minimises `f` from `x` (updated in place). `eval(x, g)` returns `f(x)` and, when `g` is given,
@@ -80,6 +83,9 @@ pub fn newton(
                     );
                     if lmin >= -1e-8 * dmax {
                         break 'outer BfgsStatus::Converged;
+                    }
+                    if !opts.escape_saddles {
+                        break 'outer BfgsStatus::Saddle;
                     }
                     let v = eig.eigenvectors.column(imin);
                     let mut escaped = false;
@@ -240,6 +246,7 @@ mod tests {
                 max_iter: 100,
                 max_step: f64::INFINITY,
                 min_iter: 0,
+                escape_saddles: true,
             },
         );
         assert_eq!(out.status, BfgsStatus::Converged);
