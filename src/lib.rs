@@ -36,6 +36,7 @@ pub mod problem;
 pub mod quadrature;
 pub mod report;
 pub mod rod;
+pub mod stability;
 pub mod statics;
 pub mod trig;
 pub mod wide;

@@ -85,12 +85,16 @@ pub struct ShapeReport {
     pub max_violation: f64,
     /// KKT residual (units of `Rf/L`); `null` for an evaluation.
     pub kkt_residual: Option<f64>,
-    /// Stability verdict; `null` if not computed.
+    /// `true` stable, `false` unstable, `null` marginal or not computed.
     pub stable: Option<bool>,
-    /// Smallest reduced-Hessian eigenvalue (units of `Rf/L`).
+    /// `"stable"`, `"unstable"` or `"marginal"`; `null` if not computed.
+    pub stability: Option<crate::stability::Verdict>,
+    /// Smallest reduced-Hessian eigenvalue against the fields' Gram matrix (units of `Rf/L`).
     pub min_reduced_eigenvalue: Option<f64>,
-    /// Reduced-Hessian eigenvalues within the stability tolerance of zero.
+    /// Eigenvalues within the verdict's resolution of zero.
     pub neutral_modes: Option<usize>,
+    /// Exact gauge directions removed before judging.
+    pub gauge_modes: Option<usize>,
     /// Pose of the `s = L` frame.
     pub end_pose: PoseReport,
     /// Poses at the report points.
@@ -143,8 +147,10 @@ impl ShapeReport {
             max_violation: sol.max_violation,
             kkt_residual: Some(sol.kkt_residual),
             stable: sol.stable,
+            stability: sol.stability,
             min_reduced_eigenvalue: sol.min_reduced_eigenvalue,
             neutral_modes: sol.neutral_modes,
+            gauge_modes: sol.gauge_modes,
             end_pose: pose(p, &sol.a, p.model.rod.length),
             points: points.iter().map(|&s| pose(p, &sol.a, s)).collect(),
             coefficients: coefficients_json(p, &sol.a),

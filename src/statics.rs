@@ -6,7 +6,6 @@ use crate::energy::EnergyTerms;
 use crate::kinematics::{Shape, rotation};
 use crate::layout::Field;
 use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
-use crate::optim::second_order::reduced_hessian_eigenvalues;
 use crate::problem::StaticProblem;
 use serde::Serialize;
 
@@ -19,11 +18,8 @@ pub struct StaticOptions {
     /// Multiplier-method settings.
     pub al: AlOptions,
     /// Whether to compute the stability verdict (one Hessian: analytic where exact, else `2n`
-    /// gradient evaluations).
+    /// gradient evaluations; see [`crate::stability`]).
     pub stability: bool,
-    /// Relative tolerance on the reduced Hessian's smallest eigenvalue: the shape is called
-    /// stable when `λ_min > −tol · max(1, |λ_max|)`.
-    pub stability_tol: f64,
 }
 
 impl Default for StaticOptions {
@@ -31,7 +27,6 @@ impl Default for StaticOptions {
         StaticOptions {
             al: AlOptions::default(),
             stability: true,
-            stability_tol: 1e-6,
         }
     }
 }
@@ -107,14 +102,19 @@ pub struct StaticSolution {
     pub balance: crate::balance::Balance,
     /// Where the rod touches itself and how hard (largest first; empty without self-contact).
     pub self_contacts: Vec<SelfContactForce>,
-    /// Stability verdict (`None` if not computed).
+    /// `Some(true)` stable, `Some(false)` unstable, `None` marginal or not computed (see
+    /// [`StaticSolution::stability`]).
     pub stable: Option<bool>,
-    /// Smallest eigenvalue of the reduced Hessian (dimensionless), if computed.
+    /// The verdict: stable, unstable or marginal (`None` if not computed).
+    pub stability: Option<crate::stability::Verdict>,
+    /// Smallest eigenvalue of the reduced Hessian against the fields' Gram matrix (units of
+    /// `Rf/L`; see [`crate::stability`]), if computed.
     pub min_reduced_eigenvalue: Option<f64>,
-    /// Reduced-Hessian eigenvalues within the stability tolerance of zero: directions along
-    /// which the second-order check cannot decide (e.g. a rotation the constraints leave free),
-    /// so a `stable` verdict holds only up to them.
+    /// Eigenvalues within the verdict's resolution of zero: directions along which the
+    /// second-order check cannot decide.
     pub neutral_modes: Option<usize>,
+    /// Exact gauge directions removed before judging (a free constant in ψ; φ−ψ on the pole).
+    pub gauge_modes: Option<usize>,
     /// Outer iterations of the multiplier method.
     pub outer_iterations: usize,
     /// Objective evaluations.
@@ -146,18 +146,13 @@ fn finish(
     out: crate::optim::AlOutcome,
     opts: &StaticOptions,
 ) -> StaticSolution {
-    let (stable, min_eig, neutral) = if opts.stability && out.status != AlStatus::NumericalFailure {
-        let ev = reduced_hessian_eigenvalues(p, &a, &out.lambda, 1e-8);
-        match (ev.first(), ev.last()) {
-            (Some(&lo), Some(&hi)) => {
-                let tol = opts.stability_tol * hi.abs().max(1.0);
-                let neutral = ev.iter().filter(|v| v.abs() <= tol).count();
-                (Some(lo > -tol), Some(lo), Some(neutral))
-            }
-            _ => (Some(true), None, Some(0)),
-        }
-    } else {
-        (None, None, None)
+    let judged = (opts.stability && out.status != AlStatus::NumericalFailure)
+        .then(|| crate::stability::judge(p, &a, &out.lambda));
+    let verdict = judged.map(|j| j.verdict);
+    let stable = match verdict {
+        Some(crate::stability::Verdict::Stable) => Some(true),
+        Some(crate::stability::Verdict::Unstable) => Some(false),
+        _ => None,
     };
     let mut c = vec![0.0; crate::optim::Nlp::m(p)];
     crate::optim::Nlp::values(p, &a, &mut c);
@@ -177,8 +172,10 @@ fn finish(
         kkt_residual: out.kkt_residual,
         reactions,
         stable,
-        min_reduced_eigenvalue: min_eig,
-        neutral_modes: neutral,
+        stability: verdict,
+        min_reduced_eigenvalue: judged.and_then(|j| j.min_eigenvalue),
+        neutral_modes: judged.map(|j| j.neutral_modes),
+        gauge_modes: judged.map(|j| j.gauge_modes),
         outer_iterations: out.outer_iterations,
         evaluations: out.evaluations,
         a,

@@ -21,9 +21,10 @@ fn greenhill(phi: f64, pairs: usize, solver: &str) -> case::Case {
     let mut psi = zeros.clone();
     psi[1] = phi;
     let h = std::f64::consts::FRAC_PI_2;
+    let panels = (4 * pairs).max(16);
     let text = format!(
         r#"{{"rod": {{"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0}},
-            "planar": false, "discretisation": {{"basis_pairs": {pairs}}},
+            "planar": false, "discretisation": {{"basis_pairs": {pairs}, "panels": {panels}}},
             "constraints": [
               {{"type": "orientation", "s": 0, "phi": 0, "theta": {h}, "psi": 0}},
               {{"type": "position", "s": 1.0, "y": 0, "z": 0}},
@@ -68,4 +69,65 @@ fn a_solve_started_on_a_stable_equilibrium_stays_on_it() {
     let phi = 1.2 * CRITICAL;
     let (u, x, _) = solve(phi, 4, "");
     assert!(u < 0.9 * 0.5 * phi * phi && x < 0.9, "U = {u}, x(L) = {x}");
+}
+
+/// The verdict on the straight twisted rod, an equilibrium at every Φ (multipliers by least
+/// squares).
+fn verdict_of_straight(phi: f64, pairs: usize) -> (dlo_planner::stability::Stability, f64) {
+    let c = greenhill(phi, pairs, "");
+    let mut p = c.problem.clone();
+    let a = c.initial.clone();
+    let m = dlo_planner::optim::Nlp::m(&p);
+    let mut cv = vec![0.0; m];
+    dlo_planner::optim::Nlp::values(&mut p, &a, &mut cv);
+    let (lambda, kkt) = dlo_planner::optim::augmented_lagrangian::least_squares_multipliers(
+        &mut p,
+        &a,
+        &cv,
+        &vec![0.0; m],
+        1e-7,
+    )
+    .unwrap();
+    (dlo_planner::stability::judge(&mut p, &a, &lambda), kkt)
+}
+
+/// The verdict decides on both sides of Greenhill's threshold as the basis locates it: the
+/// smallest eigenvalue (units of Rf/L, against the fields' Gram matrix) changes sign at a
+/// twist that, by Rayleigh–Ritz, lies above the continuum's 8.9868 and falls towards it as the
+/// basis grows; on either side of it the verdict is stable or unstable, never undecided.
+#[test]
+fn the_verdict_changes_sign_at_greenhills_threshold() {
+    let mut previous = f64::INFINITY;
+    for pairs in [4, 8, 16] {
+        let (mut lo, mut hi) = (0.9 * CRITICAL, 1.2 * CRITICAL);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            let (s, kkt) = verdict_of_straight(mid, pairs);
+            assert!(kkt < 1e-9, "the straight rod is an equilibrium: {kkt}");
+            if s.min_eigenvalue.unwrap() > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let threshold = 0.5 * (lo + hi);
+        eprintln!(
+            "{pairs} pairs: threshold {threshold:.6} ({:+.3e} relative)",
+            threshold / CRITICAL - 1.0
+        );
+        assert!(
+            threshold > CRITICAL && threshold < previous,
+            "{threshold} after {previous}"
+        );
+        previous = threshold;
+        use dlo_planner::stability::Verdict;
+        assert_eq!(
+            verdict_of_straight(threshold * 0.999, pairs).0.verdict,
+            Verdict::Stable
+        );
+        assert_eq!(
+            verdict_of_straight(threshold * 1.001, pairs).0.verdict,
+            Verdict::Unstable
+        );
+    }
 }

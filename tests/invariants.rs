@@ -110,10 +110,10 @@ fn planar_flexure_is_invariant_under_rotation_in_the_plane() {
 }
 
 /// A constant added to ψ changes neither the energy (torsion sees ψ' only) nor any position, so
-/// where no condition fixes ψ the reduced Hessian has exactly one zero eigenvalue: the solve
-/// reports it as a neutral mode next to its `stable` verdict. Fixing ψ(0) removes it.
+/// where no condition fixes ψ it is an exact gauge direction: the verdict removes it (one gauge
+/// mode) and judges the rest, stable with no neutral mode. Fixing ψ(0) leaves no gauge.
 #[test]
-fn a_free_twist_angle_is_reported_as_one_neutral_mode() {
+fn a_free_twist_angle_is_removed_as_one_gauge_mode() {
     let text = |psi: &str| {
         format!(
             r#"{{
@@ -134,7 +134,8 @@ fn a_free_twist_angle_is_reported_as_one_neutral_mode() {
         let sol = dlo_planner::statics::solve_static(&mut c.problem, &a0, &c.options);
         assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
         assert_eq!(sol.stable, Some(true));
-        neutral.push(sol.neutral_modes);
+        assert_eq!(sol.neutral_modes, Some(0));
+        neutral.push(sol.gauge_modes);
     }
     assert_eq!(neutral, [Some(1), Some(0)]);
 }

@@ -289,12 +289,18 @@ fn kinking_energy_falls_as_the_twisted_rod_is_shortened() {
         assert_eq!(sol.status, SolveStatus::Converged);
         // θ ≡ 0 is the Euler angles' singularity: the second-order check cannot decide there
         // (Greenhill's helical mode, unstable at 4π: 0.77 · 4π = 9.68 > 8.99 Rf/L, is not a
-        // small change of the angles), and says so.
+        // small change of the angles), and says so: opposite changes of φ and ψ are gauge
+        // directions there, and the verdict is marginal.
         assert!(
-            sol.neutral_modes.is_some_and(|n| n > 0),
+            sol.gauge_modes.is_some_and(|n| n > 0),
             "{:?}",
-            sol.neutral_modes
+            sol.gauge_modes
         );
+        assert_eq!(
+            sol.stability,
+            Some(dlo_planner::stability::Verdict::Marginal)
+        );
+        assert_eq!(sol.stable, None);
         sol.energy.potential()
     };
     let mut energies = Vec::new();

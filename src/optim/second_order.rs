@@ -6,21 +6,23 @@ use super::augmented_lagrangian::jacobian_rows_at;
 use super::nlp::{Nlp, Sense};
 use nalgebra::DMatrix;
 
-/// Eigenvalues of the reduced Hessian `Zᵀ ∇²ℒ Z` (ascending), where `Z` spans the null space of
-/// the Jacobian of the equality rows and of the inequality rows with `λ > lambda_tol`.
-/// Empty when the tangent space is trivial.
-pub fn reduced_hessian_eigenvalues<P: Nlp>(
+/// The Hessian of the Lagrangian at `(x, lambda)` (symmetrised; analytic where the problem says
+/// it is exact, else central differences of analytic gradients), whether it is analytic, and an
+/// orthonormal basis `Z` of the null space of the Jacobian of the equality rows and of the
+/// inequality rows with `λ > lambda_tol` (`n × 0` when the constraints leave no freedom).
+pub fn lagrangian_hessian_and_tangents<P: Nlp>(
     p: &mut P,
     x: &[f64],
     lambda: &[f64],
     lambda_tol: f64,
-) -> Vec<f64> {
+) -> (DMatrix<f64>, bool, DMatrix<f64>) {
     let (n, m) = (p.n(), p.m());
     let mut c = vec![0.0; m];
     let mut hess = DMatrix::<f64>::zeros(n, n);
     let mut analytic = vec![0.0; n * n];
     p.values(x, &mut c);
-    if p.has_hessian() && p.hessian_is_exact(lambda) {
+    let exact = p.has_hessian() && p.hessian_is_exact(lambda);
+    if exact {
         p.hessian(x, lambda, &vec![0.0; m], &mut analytic);
         hess = DMatrix::from_row_slice(n, n, &analytic);
     } else {
@@ -53,6 +55,19 @@ pub fn reduced_hessian_eigenvalues<P: Nlp>(
         let j = DMatrix::from_fn(rows.len(), n, |r, k| jr[r][k]);
         null_space(&j)
     };
+    (hess, exact, z)
+}
+
+/// Eigenvalues of the reduced Hessian `Zᵀ ∇²ℒ Z` (ascending), where `Z` spans the null space of
+/// the Jacobian of the equality rows and of the inequality rows with `λ > lambda_tol`.
+/// Empty when the tangent space is trivial.
+pub fn reduced_hessian_eigenvalues<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    lambda: &[f64],
+    lambda_tol: f64,
+) -> Vec<f64> {
+    let (hess, _, z) = lagrangian_hessian_and_tangents(p, x, lambda, lambda_tol);
     if z.ncols() == 0 {
         return Vec::new();
     }

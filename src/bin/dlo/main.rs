@@ -403,8 +403,10 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
         max_violation: ev.max_violation,
         kkt_residual: Some(ev.kkt_residual),
         stable: None,
+        stability: None,
         min_reduced_eigenvalue: None,
         neutral_modes: None,
+        gauge_modes: None,
         end_pose: pose(p, &a, p.model.rod.length),
         points: c.report_points.iter().map(|&s| pose(p, &a, s)).collect(),
         coefficients: coefficients_json(p, &a),
@@ -454,9 +456,10 @@ fn print_report(r: &ShapeReport, json: bool) {
     if let Some(k) = r.kkt_residual {
         let _ = write!(o, ", KKT residual {k:.2e}");
     }
-    o.push_str(match r.stable {
-        Some(true) => ", stable",
-        Some(false) => ", UNSTABLE",
+    o.push_str(match r.stability {
+        Some(dlo_planner::stability::Verdict::Stable) => ", stable",
+        Some(dlo_planner::stability::Verdict::Unstable) => ", UNSTABLE",
+        Some(dlo_planner::stability::Verdict::Marginal) => ", stability marginal",
         None => "",
     });
     if let Some(n @ 1..) = r.neutral_modes {
