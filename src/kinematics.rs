@@ -293,6 +293,10 @@ impl Model {
 
     /// [`Model::position_at`] from `shape`, the evaluated shape of `a`.
     pub fn position_at_in(&self, a: &[f64], shape: &Shape, t: f64) -> [f64; 3] {
+        // At a mesh boundary, the position the constraints see there.
+        if let Ok(b) = self.mesh.boundaries.binary_search_by(|x| x.total_cmp(&t)) {
+            return shape.positions[b];
+        }
         let j = self
             .mesh
             .boundaries

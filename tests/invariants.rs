@@ -192,3 +192,38 @@ fn evaluate_many_matches_evaluate_into_bit_for_bit() {
         }
     }
 }
+
+/// The reported end pose is the position the constraint that fixes it sees (the same
+/// quadrature), so it meets the constraint as exactly as the solve does; and `"y": 0` on a
+/// planar rod is accepted as the plane it lies in.
+#[test]
+fn reported_end_pose_meets_its_constraint_and_planar_y_zero_is_accepted() {
+    let path = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/pinned_buckling_080.json"
+    ));
+    let text = std::fs::read_to_string(path).unwrap();
+    let with_y = text.replace(r#""x": 0.0, "z": 80.0"#, r#""x": 0.0, "y": 0, "z": 80.0"#);
+    assert_ne!(with_y, text);
+    let mut reports = Vec::new();
+    for t in [&text, &with_y] {
+        let mut c = dlo_planner::case::parse(t, path).unwrap();
+        let a0 = c.initial.clone();
+        let sol = dlo_planner::statics::solve_static(&mut c.problem, &a0, &c.options);
+        assert!(sol.max_violation < 1e-12);
+        let r = dlo_planner::report::ShapeReport::solved(
+            &c.name,
+            &c.problem,
+            &sol,
+            &c.report_points,
+            0.0,
+        );
+        let end = r.points.last().unwrap().position;
+        assert!(
+            (end[2] - 80.0).abs() <= 1e-12 * 100.0 && end[0].abs() <= 1e-12 * 100.0,
+            "{end:?}"
+        );
+        reports.push(serde_json::to_string(&r.coefficients).unwrap());
+    }
+    assert_eq!(reports[0], reports[1], "y: 0 changes nothing");
+}

@@ -669,9 +669,14 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                         continue;
                     };
                     if !comps.contains(&k) {
-                        return Err(
-                            v.err(field(nm), "a planar rod lies in the x–z plane: remove y")
-                        );
+                        // `"y": 0` says what a planar rod does anyway.
+                        if matches!(*cs, CoordSpec::Equal(val) if val == 0.0) {
+                            continue;
+                        }
+                        return Err(v.err(
+                            field(nm),
+                            "a planar rod lies in the x–z plane: y must be 0 or absent",
+                        ));
                     }
                     match *cs {
                         CoordSpec::Equal(val) => {
@@ -730,9 +735,13 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 for (k, (nm, val)) in [("x", x), ("y", y), ("z", z)].into_iter().enumerate() {
                     let Some(val) = val else { continue };
                     if !comps.contains(&k) {
-                        return Err(
-                            v.err(field(nm), "a planar rod lies in the x–z plane: remove y")
-                        );
+                        if *val == 0.0 {
+                            continue;
+                        }
+                        return Err(v.err(
+                            field(nm),
+                            "a planar rod lies in the x–z plane: y must be 0 or absent",
+                        ));
                     }
                     v.finite(&field(nm), *val)?;
                     rows.push((k, val / l));

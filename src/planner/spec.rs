@@ -470,7 +470,13 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         for (k, (nm, val)) in xyz.into_iter().enumerate() {
             let Some(val) = val else { continue };
             if !layout.components().contains(&k) {
-                return Err(v.err(f(nm), "a planar rod lies in the x–z plane: remove y"));
+                if val == 0.0 {
+                    continue;
+                }
+                return Err(v.err(
+                    f(nm),
+                    "a planar rod lies in the x–z plane: y must be 0 or absent",
+                ));
             }
             position.push((k, v.finite(&f(nm), val)? / l));
         }
