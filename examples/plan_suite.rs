@@ -28,6 +28,11 @@ use dlo_planner::planner::{PlanResult, PlanStatus, Planner};
 use std::path::Path;
 use std::time::Instant;
 
+/// Upper bound of a capsule bar's rotation (rad): a range bound, not π, kept so that each seed
+/// gives the problems the docs quote.
+#[allow(clippy::approx_constant)]
+const ROTATION_RANGE: f64 = 3.14;
+
 /// splitmix64: a small, fixed pseudo-random sequence (the suite must not depend on a crate's
 /// generator changing).
 struct Rng(u64);
@@ -120,7 +125,7 @@ fn spatial_problem(rng: &mut Rng, i: usize) -> String {
             0 => format!(
                 r#"{{"type": "capsule", "a": [0, -1, 0], "b": [0, 1, 0], "radius": {}}}, "rotation": [0, 0, {}]"#,
                 rng.uniform(0.04, 0.1),
-                rng.uniform(0.0, 3.14)
+                rng.uniform(0.0, ROTATION_RANGE)
             ),
             1 => format!(
                 r#"{{"type": "cylinder", "half_height": 1.0, "radius": {}}}, "rotation": [0, 0, -1.5707963267948966]"#,

@@ -193,7 +193,7 @@ pub fn check_solid(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<f64,
             u[0] * v[1] - u[1] * v[0],
         ];
         let area2 = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if a == b || b == c || a == c || !(area2 > 1e-12 * diag2) {
+        if a == b || b == c || a == c || area2.is_nan() || area2 <= 1e-12 * diag2 {
             return Err(MeshDefect::Degenerate { triangle: t });
         }
         volume += (p[0] * n[0] + p[1] * n[1] + p[2] * n[2]) / 6.0;

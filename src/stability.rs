@@ -101,7 +101,7 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     // Gauge candidates: ψ + const, and φ_i − ψ_i for every basis function (the pole).
     let mut psi_shift = Vec::new();
     let mut pole = Vec::new();
-    let lay = p.model.layout.clone();
+    let lay = p.model.layout;
     if let (Some(op), Some(os)) = (lay.offset(Field::Phi), lay.offset(Field::Psi)) {
         let c = constant_coefficients(p);
         let mut g = DVector::<f64>::zeros(n);

@@ -128,10 +128,10 @@ fn apply(base: &Value, edits: &[Edit]) -> Value {
             Edit::Replace(i, x) => *get(&mut v, i.saturating_add(1)) = x.clone(),
             Edit::Delete(i) => {
                 let target = get(&mut v, *i);
-                if let Value::Object(o) = target {
-                    if let Some(k) = o.keys().nth(i % o.len().max(1)).cloned() {
-                        o.remove(&k);
-                    }
+                if let Value::Object(o) = target
+                    && let Some(k) = o.keys().nth(i % o.len().max(1)).cloned()
+                {
+                    o.remove(&k);
                 }
             }
             Edit::Copy(i, j) => {
@@ -156,10 +156,10 @@ fn check(text: &str, path: &Path) -> Result<(), TestCaseError> {
         Err(e) => named(&e)?,
         Ok(c) => {
             VALID.fetch_add(1, Relaxed);
-            if c.plan.is_some() {
-                if let Err(e) = dlo_planner::planner::spec::plan_options(&c) {
-                    named(&e)?;
-                }
+            if c.plan.is_some()
+                && let Err(e) = dlo_planner::planner::spec::plan_options(&c)
+            {
+                named(&e)?;
             }
             let mut p = c.problem.clone();
             let ev = dlo_planner::statics::evaluate_shape(&mut p, &c.initial);

@@ -1188,8 +1188,8 @@ fn trajectory_reproduces_the_plans_end_pose() {
         assert!((t.path_length - length).abs() <= 1e-12 * l);
         assert!(t.path_length >= t.straight_distance);
         let base = model.base.map(|v| v * l);
-        for c in 0..3 {
-            assert!((t.held.position[c] - base[c]).abs() <= 1e-12 * l);
+        for (c, b) in base.iter().enumerate() {
+            assert!((t.held.position[c] - b).abs() <= 1e-12 * l);
         }
     }
 }

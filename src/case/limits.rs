@@ -203,14 +203,14 @@ fn coefficients(v: &V, shape: &ShapeSpec) -> Result<(), Error> {
 /// place the tangent: twists (`ψ`, `φ + ψ`, `twist`) of several turns are common.
 fn angle_warnings(file: &CaseFile, warnings: &mut Vec<String>) {
     let mut check = |field: String, a: Option<f64>| {
-        if let Some(a) = a {
-            if a.abs() > std::f64::consts::TAU + 1e-9 {
-                warnings.push(format!(
-                    "{field}: {a} rad is more than a full turn; angles are in radians (taken as \
-                     written; {a}° would be {:.6} rad)",
-                    a.to_radians()
-                ));
-            }
+        if let Some(a) = a
+            && a.abs() > std::f64::consts::TAU + 1e-9
+        {
+            warnings.push(format!(
+                "{field}: {a} rad is more than a full turn; angles are in radians (taken as \
+                 written; {a}° would be {:.6} rad)",
+                a.to_radians()
+            ));
         }
     };
     for (i, c) in file.constraints.iter().enumerate() {

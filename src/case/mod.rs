@@ -935,7 +935,6 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             ..AlOptions::default()
         },
         stability: sv.stability,
-        ..StaticOptions::default()
     };
     let name = file.name.clone().unwrap_or_else(|| {
         path.file_stem()

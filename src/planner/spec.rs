@@ -387,7 +387,7 @@ fn end_rotation(
             v.finite(&format!("plan.{name}.tangent[{i}]"), *c)?;
         }
         let n = t.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if !(n > 0.0) || !n.is_finite() {
+        if !n.is_finite() || n <= 0.0 {
             return Err(v.err(f("tangent"), "must be a non-zero direction"));
         }
         let twist = v.finite(&f("twist"), e.twist.unwrap_or(0.0))?;
