@@ -9,7 +9,6 @@
 
 use dlo_planner::case;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -191,23 +190,7 @@ fn run_batches<S: Strategy>(
     test: impl Fn(S::Value) -> Result<(), TestCaseError>,
 ) {
     let start = Instant::now();
-    let (mut batch, mut cases) = (0u64, 0u64);
-    while batch == 0 || start.elapsed() < budget() {
-        let mut seed = [7u8; 32];
-        seed[..8].copy_from_slice(&batch.to_le_bytes());
-        let config = Config {
-            cases: 32,
-            failure_persistence: None,
-            ..Config::default()
-        };
-        let mut runner =
-            TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
-        if let Err(e) = runner.run(&strategy, &test) {
-            panic!("{name}, batch {batch}: {e}");
-        }
-        batch += 1;
-        cases += 32;
-    }
+    let cases = common::run_batches(name, 7, 32, budget(), strategy, test);
     eprintln!(
         "{name}: {cases} cases in {:.1} s ({} of {} cases read by both tests validated)",
         start.elapsed().as_secs_f64(),

@@ -11,7 +11,6 @@ use dlo_planner::mcap_log::inspect::inspect;
 use dlo_planner::mcap_log::reader::check_finished;
 use dlo_planner::mcap_log::recover::recover;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -136,28 +135,15 @@ fn fuzz(name: &str, base: &[u8], budget: Duration) {
         Ok(()),
         "{name}: the base log is finished"
     );
-    let strategy = prop::collection::vec(edit(), 1..6);
     let start = Instant::now();
-    let mut batch = 0u64;
-    let mut cases = 0u64;
-    while batch == 0 || start.elapsed() < budget {
-        let mut seed = [0u8; 32];
-        seed[..8].copy_from_slice(&batch.to_le_bytes());
-        let config = Config {
-            cases: 64,
-            failure_persistence: None,
-            ..Config::default()
-        };
-        let mut runner =
-            TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
-        if let Err(e) = runner.run(&strategy, |edits| {
-            check(base, messages, &apply(base, &edits))
-        }) {
-            panic!("{name}, batch {batch}: {e}");
-        }
-        batch += 1;
-        cases += 64;
-    }
+    let cases = common::run_batches(
+        name,
+        0,
+        64,
+        budget,
+        prop::collection::vec(edit(), 1..6),
+        |edits| check(base, messages, &apply(base, &edits)),
+    );
     eprintln!(
         "{name}: {cases} damaged logs in {:.1} s",
         start.elapsed().as_secs_f64()

@@ -185,3 +185,35 @@ pub fn fuzz_seconds() -> f64 {
         .filter(|s: &f64| s.is_finite() && *s >= 0.0)
         .unwrap_or(8.0)
 }
+
+/// Runs batches of `cases` proptest cases of `test` on `strategy`, each batch from its own fixed
+/// seed (`salt`, batch number), until `budget` has passed (at least one batch); panics naming
+/// the batch that fails, so that it can be rerun. Returns the cases run.
+pub fn run_batches<S: proptest::strategy::Strategy>(
+    name: &str,
+    salt: u8,
+    cases: u32,
+    budget: std::time::Duration,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), proptest::test_runner::TestCaseError>,
+) -> u64 {
+    use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+    let start = std::time::Instant::now();
+    let mut batch = 0u64;
+    while batch == 0 || start.elapsed() < budget {
+        let mut seed = [salt; 32];
+        seed[..8].copy_from_slice(&batch.to_le_bytes());
+        let config = Config {
+            cases,
+            failure_persistence: None,
+            ..Config::default()
+        };
+        let mut runner =
+            TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
+        if let Err(e) = runner.run(&strategy, &test) {
+            panic!("{name}, batch {batch}: {e}");
+        }
+        batch += 1;
+    }
+    batch * u64::from(cases)
+}
