@@ -187,10 +187,22 @@ fn plan_until_first_chunks(sub: &str) -> (std::process::Child, PathBuf) {
 }
 
 /// Starts `dlo plan` on the paper's case with its log in `dir`, and returns once the log it is
-/// writing (under its temporary name, `<name>.mcap.<pid>.partial`) holds a few chunks.
+/// writing (under its temporary name, `<name>.mcap.<pid>.partial`) holds a few chunks. The case
+/// verifies on a grid 50 times finer than its own, so that the run is still going (for
+/// seconds) when the caller signals or kills it, however fast the machine.
 fn plan_into_until_first_chunks(dir: &Path) -> (std::process::Child, PathBuf) {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string("planning_cases/plan_paper_planar.json").unwrap(),
+    )
+    .unwrap();
+    case["plan"]["verify_k_samples"] = 20001.into();
+    let path = dir.join("slow_plan_paper_planar.json");
+    std::fs::write(&path, case.to_string()).unwrap();
     let child = Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+        .arg("plan")
+        .arg(&path)
+        .arg("--log-dir")
         .arg(dir)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
