@@ -187,9 +187,10 @@ fn plan_until_first_chunks(sub: &str) -> (std::process::Child, PathBuf) {
 }
 
 /// Starts `dlo plan` on the paper's case with its log in `dir`, and returns once the log it is
-/// writing (under its temporary name, `<name>.mcap.<pid>.partial`) holds a few chunks. The case
-/// verifies on a grid 50 times finer than its own, so that the run is still going (for
-/// seconds) when the caller signals or kills it, however fast the machine.
+/// writing (under its temporary name, `<name>.mcap.<pid>.partial`) holds the straight path's 41
+/// shapes in finished chunks (read as `dlo inspect` reads an unfinished log), however busy the
+/// machine. The case verifies on a grid 50 times finer than its own, so that the run is still
+/// going (for seconds) when the caller signals or kills it, however fast the machine.
 fn plan_into_until_first_chunks(dir: &Path) -> (std::process::Child, PathBuf) {
     std::fs::create_dir_all(dir).unwrap();
     let mut case: serde_json::Value = serde_json::from_str(
@@ -210,7 +211,14 @@ fn plan_into_until_first_chunks(dir: &Path) -> (std::process::Child, PathBuf) {
         .unwrap();
     let log = dir.join(format!("plan_paper_planar.mcap.{}.partial", child.id()));
     let t0 = std::time::Instant::now();
-    while std::fs::metadata(&log).map_or(0, |m| m.len()) < 4000 && t0.elapsed().as_secs() < 30 {
+    let straight_on_disk = || {
+        let bytes = std::fs::read(&log).unwrap_or_default();
+        dlo_planner::mcap_log::inspect::inspect(&bytes)
+            .ok()
+            .and_then(|i| i.topics.get("/rod/straight").map(|t| t.messages))
+            == Some(41)
+    };
+    while !straight_on_disk() && t0.elapsed().as_secs() < 60 {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     (child, log)
