@@ -4,6 +4,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1
 //!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
+//!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!
 //! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
 //! three obstacles (boxes, balls, capsules along y) beyond its swing, start and goal end poses
@@ -224,10 +225,18 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
-fn run(text: &str, name: &str, plan: &serde_json::Value) -> Option<Outcome> {
+fn run(
+    text: &str,
+    name: &str,
+    plan: &serde_json::Value,
+    top: &serde_json::Value,
+) -> Option<Outcome> {
     let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
     for (key, value) in plan.as_object().into_iter().flatten() {
         v["plan"][key] = value.clone();
+    }
+    for (key, value) in top.as_object().into_iter().flatten() {
+        v[key] = value.clone();
     }
     let path = Path::new("planning_cases").join(format!("{name}.json"));
     let c = case::parse(&v.to_string(), &path).ok()?;
@@ -304,6 +313,14 @@ fn main() {
         .map_or(serde_json::json!({}), |t| {
             serde_json::from_str(t).expect("--plan: a JSON object")
         });
+    // `--case '{"angle_frame": "case"}'`: top-level case fields given to every problem.
+    let top: serde_json::Value = args
+        .iter()
+        .position(|a| a == "--case")
+        .and_then(|i| args.get(i + 1))
+        .map_or(serde_json::json!({}), |t| {
+            serde_json::from_str(t).expect("--case: a JSON object")
+        });
     let mut rng = Rng(seed);
     let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut regenerated = [0usize; 2];
@@ -317,7 +334,7 @@ fn main() {
                 spatial_problem(&mut rng, i)
             };
             i += 1;
-            match run(&text, &name, &plan) {
+            match run(&text, &name, &plan, &top) {
                 Some(o) => {
                     if verbose {
                         eprintln!(
@@ -341,7 +358,7 @@ fn main() {
         }
     }
     println!(
-        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), planner settings {}.\n",
+        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), planner settings {}{}.\n",
         n_planar,
         n_spatial,
         regenerated[0],
@@ -350,6 +367,11 @@ fn main() {
             "all at their defaults".to_string()
         } else {
             plan.to_string()
+        },
+        if top.as_object().is_none_or(|o| o.is_empty()) {
+            String::new()
+        } else {
+            format!(", case fields {top}")
         }
     );
     println!(

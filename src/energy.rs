@@ -115,13 +115,31 @@ impl Model {
             if oe.is_some() {
                 t.extensional += 0.5 * we * eps * eps;
             }
-            t.gravitational += wg * one * st * cp;
+            // The tangent's height `ζ·x̂`, and its θ and φ derivatives: `sθcφ` in the case's
+            // axes; `u·ζ` for the vertical `u` of an angles' frame.
+            let (up, up_th, up_ph) = match self.up {
+                None => (st * cp, ct * cp, -st * sp),
+                Some(u) => (
+                    u[0] * st * cp + u[1] * st * sp + u[2] * ct,
+                    u[0] * ct * cp + u[1] * ct * sp - u[2] * st,
+                    -u[0] * st * sp + u[1] * st * cp,
+                ),
+            };
+            if self.up.is_none() {
+                t.gravitational += wg * one * st * cp;
+            } else {
+                t.gravitational += wg * one * up;
+            }
             let Some(g) = grad.as_deref_mut() else {
                 continue;
             };
             let (e, de) = (self.e_at(q), self.de_at(q));
             // d/dθ (value) and d/dθ' terms
-            let mut g_th = wg * one * ct * cp;
+            let mut g_th = if self.up.is_none() {
+                wg * one * ct * cp
+            } else {
+                wg * one * up_th
+            };
             let g_dth = wf * dth;
             if spatial {
                 g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
@@ -130,7 +148,11 @@ impl Model {
                 g[i] += g_th * e[i] + g_dth * de[i];
             }
             if let (Some(op), Some(ops)) = (op, ops) {
-                let g_ph = -wg * one * st * sp;
+                let g_ph = if self.up.is_none() {
+                    -wg * one * st * sp
+                } else {
+                    wg * one * up_ph
+                };
                 let g_dph = wf * dph * st * st + wt * omega * ct;
                 let g_dps = wt * omega;
                 for i in 0..nb {
@@ -139,7 +161,11 @@ impl Model {
                 }
             }
             if let Some(oe) = oe {
-                let g_e = we * eps + wg * st * cp;
+                let g_e = if self.up.is_none() {
+                    we * eps + wg * st * cp
+                } else {
+                    we * eps + wg * up
+                };
                 for i in 0..nb {
                     g[oe + i] += g_e * e[i];
                 }

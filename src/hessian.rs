@@ -126,12 +126,21 @@ impl Model {
                 let one = 1.0 + shape.eps[q];
                 let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
                 let omega = dph * ct + dps;
-                // Gravity: wg (1+ε) sθ cφ.
-                hq[TH][TH] = -wg * one * st * cp;
-                hq[TH][PH] = -wg * one * ct * sp;
-                hq[PH][PH] = -wg * one * st * cp;
-                hq[TH][EPS] = wg * ct * cp;
-                hq[PH][EPS] = -wg * st * sp;
+                // Gravity: wg (1+ε) sθ cφ; wg (1+ε) u·ζ for the vertical `u` of an angles' frame.
+                if let Some(u) = self.up {
+                    let f = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
+                    hq[TH][TH] = -wg * one * f;
+                    hq[TH][PH] = wg * one * (-u[0] * ct * sp + u[1] * ct * cp);
+                    hq[PH][PH] = -wg * one * (u[0] * st * cp + u[1] * st * sp);
+                    hq[TH][EPS] = wg * (u[0] * ct * cp + u[1] * ct * sp - u[2] * st);
+                    hq[PH][EPS] = wg * (-u[0] * st * sp + u[1] * st * cp);
+                } else {
+                    hq[TH][TH] = -wg * one * st * cp;
+                    hq[TH][PH] = -wg * one * ct * sp;
+                    hq[PH][PH] = -wg * one * st * cp;
+                    hq[TH][EPS] = wg * ct * cp;
+                    hq[PH][EPS] = -wg * st * sp;
+                }
                 // Flexure: ½ wf (θ'² + φ'² sθ²); its θ'θ' part, torsion's ψ'ψ' and extension's εε
                 // are constant (in `constant_hessian`).
                 if spatial {
@@ -177,7 +186,8 @@ impl Model {
             for k in 0..3 {
                 acc[k] += v[j + 1][k];
             }
-            suffix[j] = acc;
+            // In the angles' frame.
+            suffix[j] = self.to_angles(acc);
         }
         if suffix.iter().all(|s| *s == [0.0; 3]) {
             return;
@@ -276,9 +286,15 @@ impl Model {
         let op = lay.offset(Field::Phi);
         let oe = lay.offset(Field::Eps);
         let mut jac = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        // Rows in the angles' frame (`Jᵀ J` is the same in any axes): the base's rows are `Rᵀ`.
         if let Some(o) = lay.base_offset() {
             for (k, &comp) in lay.components().iter().enumerate() {
-                jac[comp][o + k] = 1.0;
+                let mut unit = [0.0; 3];
+                unit[comp] = 1.0;
+                let local = self.to_angles(unit);
+                for (row, v) in jac.iter_mut().zip(local) {
+                    row[o + k] = v;
+                }
             }
         }
         let ps = &self.mesh.panel_start;
@@ -415,6 +431,144 @@ mod tests {
             loads,
             &[],
         )
+    }
+
+    /// A 3D, extensible, heavy rod with a free base and a point load, its angles measured from
+    /// a generic frame (so that gravity reads all three components of the tangent).
+    fn framed() -> Model {
+        let mut m = model(true, true);
+        m.layout.free_base = true;
+        let m = Model::new(
+            m.rod.clone(),
+            m.layout,
+            Discretisation {
+                panels: 6,
+                gauss_points: 3,
+            },
+            [0.1, -0.2, 0.3],
+            m.loads.clone(),
+            &[],
+        );
+        m.with_frame(crate::kinematics::rotation(0.4, 1.1, -0.7))
+            .expect("a rotation")
+    }
+
+    /// The framed model's energy gradient and positions' vector–Jacobian product against
+    /// central differences, and its energy Hessian, position curvature and Gauss–Newton
+    /// Hessian against differences of those and the position Jacobians.
+    #[test]
+    fn framed_derivatives_match_finite_differences() {
+        let m = framed();
+        let n = m.n();
+        let a = coefficients(n);
+        let step = 1e-6;
+        let close = |x: f64, y: f64, scale: f64, what: &str| {
+            assert!((x - y).abs() < 1e-6 * scale.max(1.0), "{what}: {x} vs {y}");
+        };
+        for objective in [Objective::Internal, Objective::Potential] {
+            let mut sh = m.evaluate(&a);
+            let mut g = vec![0.0; n];
+            m.objective_and_gradient(&a, objective, &mut sh, &mut g);
+            let mut g2 = vec![0.0; n];
+            for j in 0..n {
+                let mut x = a.clone();
+                x[j] += step;
+                let fp = m.objective_and_gradient(&x, objective, &mut sh, &mut g2);
+                x[j] -= 2.0 * step;
+                let fm = m.objective_and_gradient(&x, objective, &mut sh, &mut g2);
+                close(
+                    g[j],
+                    (fp - fm) / (2.0 * step),
+                    g[j].abs(),
+                    "energy gradient",
+                );
+            }
+            let mut sh = m.evaluate(&a);
+            let mut h = vec![0.0; n * n];
+            m.add_energy_hessian(&sh, objective, 1.0, &mut h);
+            let fd = fd_hessian(
+                n,
+                |x, g| {
+                    m.objective_and_gradient(x, objective, &mut sh, g);
+                },
+                &a,
+            );
+            assert_close(&h, &fd);
+        }
+        // Positions: v · ∂x/∂a against differences of v · x.
+        let nbd = m.mesh.boundaries.len();
+        let v: Vec<[f64; 3]> = (0..nbd)
+            .map(|b| {
+                let t = b as f64;
+                [(0.9 * t).sin(), (1.3 * t).cos(), 0.4 - 0.1 * t]
+            })
+            .collect();
+        let dot = |x: &[f64]| -> f64 {
+            let p = m.evaluate(x).positions;
+            p.iter()
+                .zip(&v)
+                .map(|(p, v)| p[0] * v[0] + p[1] * v[1] + p[2] * v[2])
+                .sum()
+        };
+        let mut g = vec![0.0; n];
+        m.add_positions_vjp(&m.evaluate(&a), &v, &mut g);
+        for j in 0..n {
+            let mut x = a.clone();
+            x[j] += step;
+            let fp = dot(&x);
+            x[j] -= 2.0 * step;
+            let fm = dot(&x);
+            close(g[j], (fp - fm) / (2.0 * step), g[j].abs(), "positions' VJP");
+        }
+        let sh = m.evaluate(&a);
+        let mut h = vec![0.0; n * n];
+        m.add_positions_hessian(&sh, &v, &mut h);
+        let fd = fd_hessian(
+            n,
+            |x, g| {
+                g.iter_mut().for_each(|v| *v = 0.0);
+                m.add_positions_vjp(&m.evaluate(x), &v, g);
+            },
+            &a,
+        );
+        assert_close(&h, &fd);
+        let c: Vec<f64> = (0..nbd).map(|b| 0.5 + 0.1 * b as f64).collect();
+        let mut h = vec![0.0; n * n];
+        m.add_positions_gauss_newton(&sh, &c, &mut h);
+        let mut expect = vec![0.0; n * n];
+        for (b, &cb) in c.iter().enumerate() {
+            for row in &m.position_jacobian(&sh, b) {
+                for i in 0..n {
+                    for j in 0..n {
+                        expect[i * n + j] += cb * row[i] * row[j];
+                    }
+                }
+            }
+        }
+        assert_close(&h, &expect);
+        // The frame turns the shape: the same coefficients without it give the positions
+        // turned back.
+        let mut plain = model(true, true);
+        plain.layout.free_base = true;
+        let plain = Model::new(
+            plain.rod.clone(),
+            plain.layout,
+            Discretisation {
+                panels: 6,
+                gauss_points: 3,
+            },
+            [0.1, -0.2, 0.3],
+            plain.loads.clone(),
+            &[],
+        );
+        let (p, q) = (plain.evaluate(&a).positions, sh.positions.clone());
+        let base = m.base_position(&a);
+        for (p, q) in p.iter().zip(&q) {
+            let d = m.to_case(std::array::from_fn(|k| p[k] - base[k]));
+            for k in 0..3 {
+                assert!((base[k] + d[k] - q[k]).abs() < 1e-14, "{p:?} {q:?}");
+            }
+        }
     }
 
     fn coefficients(n: usize) -> Vec<f64> {

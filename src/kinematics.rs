@@ -169,6 +169,8 @@ impl Model {
             if suffix == [0.0; 3] {
                 continue;
             }
+            // In the angles' frame.
+            let suffix = self.to_angles(suffix);
             for q in ps[j]..ps[j + 1] {
                 let w = self.mesh.weights[q];
                 let one = 1.0 + shape.eps[q];
@@ -222,6 +224,7 @@ impl Model {
             if suffix == [0.0; 3] {
                 continue;
             }
+            let suffix = self.to_angles(suffix);
             // The panel's nodes as slices: no bounds check per node.
             let r = ps[j]..ps[j + 1];
             let nodes = self.mesh.weights[r.clone()]
@@ -279,6 +282,13 @@ impl Model {
         [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
     }
 
+    /// The cross-section's frame at `t` in the case's axes, `R A(φ, θ, ψ)` (row-major; its
+    /// columns are `ξ, η, ζ`).
+    pub fn frame_at(&self, a: &[f64], t: f64) -> [[f64; 3]; 3] {
+        let [phi, theta, psi] = self.angles_at(a, t);
+        self.rotation_to_case(rotation(phi, theta, psi))
+    }
+
     /// Strain `ε` at `t` (zero for inextensible rods).
     pub fn strain_at(&self, a: &[f64], t: f64) -> f64 {
         self.layout
@@ -303,7 +313,8 @@ impl Model {
             .partition_point(|&b| b <= t)
             .saturating_sub(1);
         let j = j.min(self.mesh.panels() - 1);
-        let mut x = shape.positions[j];
+        let x0 = shape.positions[j];
+        let mut x = if self.frame.is_some() { [0.0; 3] } else { x0 };
         let t0 = self.mesh.boundaries[j];
         let (gx, gw) = crate::quadrature::gauss_legendre(8);
         let h = t - t0;
@@ -315,6 +326,10 @@ impl Model {
             x[0] += w * th.sin() * ph.cos();
             x[1] += w * th.sin() * ph.sin();
             x[2] += w * th.cos();
+        }
+        if self.frame.is_some() {
+            let d = self.to_case(x);
+            return [x0[0] + d[0], x0[1] + d[1], x0[2] + d[2]];
         }
         x
     }
@@ -463,7 +478,8 @@ fn evaluate_fields_body(m: &Model, a: &[f64], shape: &mut Shape) -> bool {
         // ([`planar_sums_body`]).
         return true;
     }
-    let mut x = base;
+    // With an angles' frame R the sums run in that frame from zero and are turned after.
+    let mut x = if m.frame.is_some() { [0.0; 3] } else { base };
     let out = shape.positions[1..].iter_mut();
     let w = m.mesh.weights.chunks_exact(g);
     let (st, ct) = (shape.sth.chunks_exact(g), shape.cth.chunks_exact(g));
@@ -479,7 +495,28 @@ fn evaluate_fields_body(m: &Model, a: &[f64], shape: &mut Shape) -> bool {
         }
         *p = x;
     }
+    if m.frame.is_some() {
+        for p in &mut shape.positions[1..] {
+            let d = m.to_case(*p);
+            *p = [base[0] + d[0], base[1] + d[1], base[2] + d[2]];
+        }
+    }
     false
+}
+
+/// Euler angles `(φ, θ, ψ)` of the rotation `m` (row-major) with `θ ∈ [0, π]`, `φ, ψ ∈ (−π, π]`
+/// (at the poles, where only `φ ± ψ` is defined, `φ = 0`).
+pub fn angles_of(m: [[f64; 3]; 3]) -> [f64; 3] {
+    let theta = m[2][2].clamp(-1.0, 1.0).acos();
+    if theta.sin() > 1e-12 {
+        [m[1][2].atan2(m[0][2]), theta, m[2][1].atan2(-m[2][0])]
+    } else if m[2][2] > 0.0 {
+        // θ = 0: A = Rz(φ + ψ).
+        [0.0, theta, m[1][0].atan2(m[0][0])]
+    } else {
+        // θ = π: A = Rz(φ) diag(−1, 1, −1) Rz(ψ) depends on φ − ψ only.
+        [0.0, theta, -(-m[0][1]).atan2(-m[0][0])]
+    }
 }
 
 /// The rotation matrix `A(φ, θ, ψ) = Rz(φ) Ry(θ) Rz(ψ)` of eq. (1), row-major; its columns are

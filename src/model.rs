@@ -99,6 +99,12 @@ pub struct Model {
     /// For a planar rod without gravity, whose energy is the quadratic form `½ aᵀ K a` of
     /// `constant_hessian`: `K` as a sum of squares `Σ_r (R_r · a)²` (empty otherwise).
     pub(crate) energy_roots: Vec<EnergyRoot>,
+    /// The angles' reference frame `R` (row-major): the frame of the fields' Euler angles is
+    /// `R A(φ, θ, ψ)` and positions are `x(0) + R ∫ (1+ε) ζ`, so the ZYZ pole (`θ = 0, π`)
+    /// lies along `R ẑ`. `None` is the identity (the case's own axes, as in the paper).
+    pub(crate) frame: Option<[[f64; 3]; 3]>,
+    /// With a frame, the vertical `x̂` in the angles' frame (`Rᵀ x̂`), which gravity reads.
+    pub(crate) up: Option<[f64; 3]>,
 }
 
 /// One square-root row of the constant energy Hessian: `√λ v` for an eigenpair `(λ, v)` of its
@@ -170,6 +176,8 @@ impl Model {
             gravity_total,
             constant_hessian: Vec::new(),
             energy_roots: Vec::new(),
+            frame: None,
+            up: None,
         };
         model.constant_hessian = model.assemble_constant_hessian();
         if !model.layout.spatial && model.gravity_total == 0.0 && model.wg.iter().all(|&w| w == 0.0)
@@ -205,6 +213,79 @@ impl Model {
             }
         }
         roots
+    }
+
+    /// Sets the angles' reference frame `R` (row-major, a proper rotation): the Euler angles
+    /// then describe `Rᵀ` times the case's frames, and the ZYZ pole lies along `R ẑ`. Only a
+    /// 3D rod can take one other than the identity; `None` if `R` is refused.
+    pub fn with_frame(mut self, r: [[f64; 3]; 3]) -> Option<Model> {
+        let ortho = (0..3).all(|i| {
+            (0..3).all(|j| {
+                let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
+                (d - f64::from(u8::from(i == j))).abs() < 1e-12
+            })
+        });
+        let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+            - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+            + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+        let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
+        if !ortho || det <= 0.0 || !(self.layout.spatial || identity) {
+            return None;
+        }
+        self.frame = (!identity).then_some(r);
+        // The vertical in the angles' frame: `Rᵀ x̂`, the first row of R.
+        self.up = self.frame.map(|r| r[0]);
+        Some(self)
+    }
+
+    /// The angles' reference frame `R` (row-major; the identity unless
+    /// [`Model::with_frame`] set another).
+    pub fn frame(&self) -> [[f64; 3]; 3] {
+        self.frame
+            .unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    }
+
+    /// The angles' reference frame `R` if it is not the identity.
+    pub fn angle_frame(&self) -> Option<[[f64; 3]; 3]> {
+        self.frame
+    }
+
+    /// `R v`: a vector of the angles' frame in the case's axes.
+    #[inline]
+    pub fn to_case(&self, v: [f64; 3]) -> [f64; 3] {
+        match &self.frame {
+            None => v,
+            Some(r) => std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2]),
+        }
+    }
+
+    /// `Rᵀ v`: a vector of the case's axes in the angles' frame.
+    #[inline]
+    pub fn to_angles(&self, v: [f64; 3]) -> [f64; 3] {
+        match &self.frame {
+            None => v,
+            Some(r) => std::array::from_fn(|i| r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2]),
+        }
+    }
+
+    /// `R m`: a rotation written in the angles' frame, in the case's axes.
+    pub fn rotation_to_case(&self, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        match &self.frame {
+            None => m,
+            Some(r) => std::array::from_fn(|i| {
+                std::array::from_fn(|j| (0..3).map(|k| r[i][k] * m[k][j]).sum())
+            }),
+        }
+    }
+
+    /// `Rᵀ m`: a rotation in the case's axes, written in the angles' frame.
+    pub fn rotation_to_angles(&self, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        match &self.frame {
+            None => m,
+            Some(r) => std::array::from_fn(|i| {
+                std::array::from_fn(|j| (0..3).map(|k| r[k][i] * m[k][j]).sum())
+            }),
+        }
     }
 
     /// Number of unknowns.

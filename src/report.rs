@@ -1,7 +1,7 @@
 //! Machine-readable summaries of solves, shared by the CLI's `--json` output and tests.
 
 use crate::energy::EnergyTerms;
-use crate::kinematics::rotation;
+use crate::kinematics::angles_of;
 use crate::problem::StaticProblem;
 use crate::statics::{Reaction, StaticSolution};
 use serde::Serialize;
@@ -46,9 +46,10 @@ pub struct PoseReport {
     pub s: f64,
     /// Position (case units).
     pub position: [f64; 3],
-    /// Rotation matrix `A(φ, θ, ψ)` (rows), columns `ξ, η, ζ`.
+    /// The frame's rotation matrix (rows) in the case's axes, columns `ξ, η, ζ`.
     pub rotation: [[f64; 3]; 3],
-    /// Euler angles `[φ, θ, ψ]` (radians).
+    /// Euler angles `[φ, θ, ψ]` of `rotation` (radians): the fields' own values, or, where
+    /// the rod's angles have their own reference frame, the principal angles of `rotation`.
     pub euler_zyz: [f64; 3],
 }
 
@@ -58,11 +59,17 @@ pub fn pose(p: &StaticProblem, a: &[f64], s: f64) -> PoseReport {
     let l = m.rod.length;
     let t = s / l;
     let ang = m.angles_at(a, t);
+    let rotation = m.frame_at(a, t);
     PoseReport {
         s,
         position: m.position_at(a, t).map(|c| c * l),
-        rotation: rotation(ang[0], ang[1], ang[2]),
-        euler_zyz: ang,
+        rotation,
+        // With an angles' frame the fields' angles are not the case's: these are.
+        euler_zyz: if m.frame.is_some() {
+            angles_of(rotation)
+        } else {
+            ang
+        },
     }
 }
 
@@ -99,8 +106,11 @@ pub struct ShapeReport {
     pub end_pose: PoseReport,
     /// Poses at the report points.
     pub points: Vec<PoseReport>,
-    /// Ritz coefficients by field.
+    /// Ritz coefficients by field, of the angles measured from `angle_frame`.
     pub coefficients: serde_json::Value,
+    /// The frame `R` (row-major; columns the angles' x, y, z axes in the case's) from which a
+    /// 3D rod's angles are measured; `null` for the case's own axes.
+    pub angle_frame: Option<[[f64; 3]; 3]>,
     /// Outer iterations of the multiplier method.
     pub outer_iterations: Option<usize>,
     /// Wall-clock seconds.
@@ -154,6 +164,7 @@ impl ShapeReport {
             end_pose: pose(p, &sol.a, p.model.rod.length),
             points: points.iter().map(|&s| pose(p, &sol.a, s)).collect(),
             coefficients: coefficients_json(p, &sol.a),
+            angle_frame: p.model.frame,
             outer_iterations: Some(sol.outer_iterations),
             timing_s: secs,
         }

@@ -342,8 +342,9 @@ fn least_squares_moment(
     let amat = DMatrix::from_fn(rows.len(), 3, |i, j| axes[rows[i]][j]);
     let b = DVector::from_iterator(rows.len(), rows.iter().map(|&r| torques[r]));
     let svd = amat.svd(true, true);
+    // The axes are the angles' frame's: the moment in the case's axes is `R M`.
     match svd.solve(&b, 1e-9) {
-        Ok(x) => [x[0], x[1], x[2]],
+        Ok(x) => m.to_case([x[0], x[1], x[2]]),
         Err(_) => [0.0; 3],
     }
 }

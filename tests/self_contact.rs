@@ -14,9 +14,14 @@ use std::path::Path;
 /// loop can only reach its second clamp by crossing its first leg), with or without
 /// self-contact.
 fn crossed_loop(self_contact: bool) -> (case::Case, StaticSolution) {
+    crossed_loop_in(self_contact, "auto")
+}
+
+/// [`crossed_loop`] with its angles measured as `angle_frame` says.
+fn crossed_loop_in(self_contact: bool, angle_frame: &str) -> (case::Case, StaticSolution) {
     let text = shipped("self_contact_crossed_loop").replace(
         r#""self_contact": true"#,
-        &format!(r#""self_contact": {self_contact}"#),
+        &format!(r#""self_contact": {self_contact}, "angle_frame": "{angle_frame}""#),
     );
     let mut c = case::parse(&text, Path::new("crossed_loop.json")).unwrap();
     let a0 = c.initial.clone();
@@ -107,10 +112,13 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
 /// chords 2r apart on the verification grid, which it never saw, at the same U_max (the end
 /// shapes' energy), and the end pose alone reproduces it, from the start shape itself at k = 0
 /// (its first solve starts from the start shape's contact forces; started without them, it
-/// passed the legs through each other into the mirror image, 0.012 L away) to the goal.
+/// passed the legs through each other into the mirror image, 0.012 L away) to the goal. The
+/// flip case writes its shapes as coefficients, so its angles are the case's own
+/// (`src/case/frame.rs`), and so are this test's.
 #[test]
 fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
-    let (c, held) = crossed_loop(true);
+    // The flip case writes its end shapes as coefficients of the case's own angles.
+    let (c, held) = crossed_loop_in(true, "case");
     // The shipped start is this solve's shape.
     let lay = &c.problem.model.layout;
     let flip = case::parse(&shipped("plan_loop_flip"), Path::new("flip.json")).unwrap();

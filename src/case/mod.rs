@@ -3,6 +3,7 @@
 //! README with its units and default. Lengths, forces and rigidities are in any one consistent
 //! unit system; angles in radians.
 
+pub mod frame;
 mod limits;
 mod strict_json;
 
@@ -63,6 +64,11 @@ pub struct CaseFile {
     pub self_contact: bool,
     /// Explicit Ritz coefficients: evaluated by `dlo energy`, the start of `dlo shape`.
     pub shape: Option<ShapeSpec>,
+    /// How a 3D rod's Euler angles are measured: `"auto"` from a frame chosen away from the
+    /// pole, `"case"` in the case's own axes, or an explicit frame (see [`frame`]). Default:
+    /// `"auto"`, but `"case"` in a case with a `plan` section.
+    #[serde(default)]
+    pub angle_frame: Option<frame::AngleFrameSpec>,
     /// Arc lengths at which `dlo energy`/`dlo shape` report positions (default: 0, L/4, …, L).
     pub report_points: Option<Vec<f64>>,
     /// Solver settings.
@@ -645,6 +651,15 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         loads,
         &points,
     );
+    // The angles' reference frame, away from the pole where the case allows it.
+    let angle_frame = frame::choose(&file).map_err(|m| v.err("angle_frame", m))?;
+    let (model, converted) = match angle_frame.and_then(|r| model.clone().with_frame(r)) {
+        Some(m) => {
+            let rows = frame::convert(&file, &m.frame());
+            (m, Some(rows))
+        }
+        None => (model, None),
+    };
 
     let mut constraints: Vec<Box<dyn Constraint>> = Vec::new();
     // Fixed points for the reachability check: (t, position, all components fixed).
@@ -805,6 +820,10 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                         "an orientation constraint needs at least one angle",
                     ));
                 }
+                // In the angles' frame, if the rod has one.
+                if let Some(Some(local)) = converted.as_ref().map(|c| c[i].clone()) {
+                    rows = local;
+                }
                 constraints.push(Box::new(OrientationConstraint::new(
                     &model,
                     name.clone()
@@ -893,10 +912,23 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?,
             true,
         ),
-        None => (
-            default_start(&layout, file.solver.perturbation, base.map(|c| c / l)),
-            false,
-        ),
+        None => {
+            let mut a = default_start(&layout, file.solver.perturbation, base.map(|c| c / l));
+            // Along the held end's orientation in the angles' frame.
+            if let Some(rows) = &converted {
+                let held = frame::held_angles(rows, &file);
+                for (f, v) in [
+                    (Field::Phi, held[0]),
+                    (Field::Theta, held[1]),
+                    (Field::Psi, held[2]),
+                ] {
+                    if let Some(o) = layout.offset(f) {
+                        a[o] += v;
+                    }
+                }
+            }
+            (a, false)
+        }
     };
     let report_points = match &file.report_points {
         Some(p) => {

@@ -214,7 +214,7 @@ impl PlanObserver for PlanLog {
             PathKind::Optimal => ("optimal", color(0.1, 0.4, 0.9, 0.45), 1.6 * thick),
             PathKind::Feasible => ("feasible", color(0.9, 0.2, 0.2, 1.0), 0.6 * thick),
         };
-        let angles = model.angles_at(r.a, 1.0);
+        let frame = model.frame_at(r.a, 1.0);
         let end = *pts.last().expect("at least two boundaries");
         let metrics = metrics(r);
         let reactions =
@@ -226,7 +226,7 @@ impl PlanObserver for PlanLog {
                 &rod_update(t, id, &pts, thickness, c),
             )?;
             if matches!(r.kind, PathKind::Optimal | PathKind::Feasible) {
-                w.proto(&format!("/end_pose/{name}"), t, &end_pose(t, end, angles))?;
+                w.proto(&format!("/end_pose/{name}"), t, &end_pose(t, end, frame))?;
             }
             w.json(
                 &format!("/metrics/{name}"),
@@ -299,7 +299,7 @@ pub fn log_static(
     w.proto(
         "/end_pose/shape",
         t0,
-        &end_pose(t0, end, model.angles_at(a, 1.0)),
+        &end_pose(t0, end, model.frame_at(a, 1.0)),
     )?;
     w.json(
         "/metrics/shape",

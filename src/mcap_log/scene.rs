@@ -5,7 +5,6 @@
 //! `world → rod` maps the paper's x to Foxglove's z (up), its z to Foxglove's x, and its y to
 //! −y (a proper rotation: 180° about `(x + z)/√2`).
 
-use crate::kinematics::rotation;
 use crate::obstacle::{Obstacle, ObstacleShape};
 use foxglove::schemas::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3, Pose,
@@ -167,14 +166,14 @@ pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], thickness: f64, c: Colo
     }
 }
 
-/// The pose of the rod's cross-section at `position` with Euler angles `(φ, θ, ψ)`.
-pub fn end_pose(t: u64, position: [f64; 3], angles: [f64; 3]) -> PoseInFrame {
+/// The pose of the rod's cross-section at `position` with frame `frame` (row-major).
+pub fn end_pose(t: u64, position: [f64; 3], frame: [[f64; 3]; 3]) -> PoseInFrame {
     PoseInFrame {
         timestamp: Some(stamp(t)),
         frame_id: ROD_FRAME.into(),
         pose: Some(Pose {
             position: Some(v3(position)),
-            orientation: Some(quaternion(rotation(angles[0], angles[1], angles[2]))),
+            orientation: Some(quaternion(frame)),
         }),
     }
 }
@@ -376,6 +375,7 @@ fn frame_with_z(z: [f64; 3]) -> [[f64; 3]; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::rotation;
 
     #[test]
     fn quaternion_round_trips_a_rotation() {

@@ -255,28 +255,33 @@ fn end_angles(end: &End) -> Option<[f64; 3]> {
 /// constraints at `s = 0` (a prescribed `φ + ψ` counts as `ψ`), zero where nothing is
 /// prescribed (the natural state's frame); and whether `φ(0)` itself is prescribed.
 fn held_frame(case: &Case) -> ([f64; 3], bool) {
+    use crate::constraints::{Angle, OrientationConstraint};
+    use crate::layout::Field;
     let mut angles = [0.0; 3];
     let mut phi_fixed = false;
-    for c in &case.file.constraints {
-        if let crate::case::ConstraintSpec::Orientation {
-            s,
-            phi,
-            theta,
-            psi,
-            phi_plus_psi,
-            ..
-        } = c
-            && *s == 0.0
-        {
-            for (i, v) in [*phi, *theta, *psi].into_iter().enumerate() {
-                if let Some(v) = v {
-                    angles[i] = v;
+    // The rows the problem holds (in the rod's angles' frame, which may not be the case's).
+    for c in &case.problem.constraints {
+        let Some(oc) = c.as_any().downcast_ref::<OrientationConstraint>() else {
+            continue;
+        };
+        if oc.t != 0.0 {
+            continue;
+        }
+        let mut sum = None;
+        for &(ang, v) in &oc.rows {
+            match ang {
+                Angle::Field(Field::Phi) => {
+                    angles[0] = v;
+                    phi_fixed = true;
                 }
+                Angle::Field(Field::Theta) => angles[1] = v,
+                Angle::Field(Field::Psi) => angles[2] = v,
+                Angle::PhiPlusPsi => sum = Some(v),
+                Angle::Field(Field::Eps) => {}
             }
-            if let Some(sum) = phi_plus_psi {
-                angles[2] = sum - angles[0];
-            }
-            phi_fixed |= phi.is_some();
+        }
+        if let Some(sum) = sum {
+            angles[2] = sum - angles[0];
         }
     }
     (angles, phi_fixed)
@@ -297,9 +302,8 @@ impl Planner {
         // Full orientations take the Euler branch that continues from the held end's frame
         // (start) and from the start shape's end (goal).
         let model = &case.problem.model;
-        let planar = !model.layout.spatial;
         let resolve = |end: &mut End, field: &str, reference: [f64; 3]| {
-            end.resolve(planar, reference)
+            end.resolve(model, reference)
                 .map_err(|m| Error::invalid(&case.path, format!("plan.{field}"), m))
         };
         let mut options = options;

@@ -35,18 +35,9 @@ pub fn tangent_twist(tangent: [f64; 3], twist: f64) -> Matrix {
     rotation(phi, theta, twist - phi)
 }
 
-/// Euler angles `(φ, θ, ψ)` of `m` with `θ ∈ [0, π]` (at the poles, `φ = 0`).
+/// Euler angles of `m` with `θ ∈ [0, π]` (at the poles, `φ = 0`).
 fn principal(m: Matrix) -> [f64; 3] {
-    let theta = m[2][2].clamp(-1.0, 1.0).acos();
-    if theta.sin() > 1e-12 {
-        [m[1][2].atan2(m[0][2]), theta, m[2][1].atan2(-m[2][0])]
-    } else if m[2][2] > 0.0 {
-        // θ = 0: A = Rz(φ + ψ).
-        [0.0, theta, m[1][0].atan2(m[0][0])]
-    } else {
-        // θ = π: A = Rz(φ) diag(−1, 1, −1) Rz(ψ) depends on φ − ψ only.
-        [0.0, theta, -(-m[0][1]).atan2(-m[0][0])]
-    }
+    crate::kinematics::angles_of(m)
 }
 
 /// `x + 2πn` nearest `target`.

@@ -261,7 +261,12 @@ impl End {
     /// `reference` (the Euler angles of the frame it continues from; see
     /// [`super::orientation`]). Errors name the problem (a planar rod's end turned about
     /// another axis than y).
-    pub fn resolve(&mut self, planar: bool, reference: [f64; 3]) -> Result<(), String> {
+    pub fn resolve(
+        &mut self,
+        model: &crate::model::Model,
+        reference: [f64; 3],
+    ) -> Result<(), String> {
+        let planar = !model.layout.spatial;
         use crate::layout::Field;
         let Some(r) = self.rotation.take() else {
             return Ok(());
@@ -272,8 +277,11 @@ impl End {
             )?;
             self.angles = vec![(Field::Theta, theta)];
         } else {
+            // In the rod's angles' frame; a written φ is the case's, not the fields'.
+            let written_phi = r.written_phi.filter(|_| model.frame.is_none());
+            let matrix = model.rotation_to_angles(r.matrix);
             let [phi, theta, psi] =
-                super::orientation::euler_branch(r.matrix, reference, r.written_phi);
+                super::orientation::euler_branch(matrix, reference, written_phi);
             self.angles = vec![(Field::Phi, phi), (Field::Theta, theta), (Field::Psi, psi)];
         }
         Ok(())

@@ -7,7 +7,7 @@
 //! `η` and the tangent `ζ`. A robot whose base frame `B` sees the case frame at rotation `R_B`
 //! and origin `t_B` commands `p_B = R_B p + t_B` and `q_B = q(R_B) ⊗ q`.
 
-use crate::kinematics::{Shape, rotation};
+use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::path::DeformationPath;
 use serde::Serialize;
@@ -137,8 +137,7 @@ fn pose_at(model: &Model, a: &[f64], shape: &Shape, t: f64, k: f64) -> GripperPo
     let l = model.rod.length;
     let b = model.boundary(t);
     let position = shape.positions[b].map(|v| v * l);
-    let [phi, theta, psi] = model.angles_at(a, t);
-    let m = rotation(phi, theta, psi);
+    let m = model.frame_at(a, t);
     let mut q = quaternion_of(m);
     if q[0] < 0.0 {
         q = q.map(|v| -v);
@@ -278,6 +277,7 @@ impl Trajectory {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::rotation;
 
     #[test]
     fn quaternion_and_matrix_round_trip() {

@@ -11,12 +11,12 @@ use serde::Serialize;
 use std::sync::Arc;
 
 /// The verification model: the case's rod with `s_intervals` uniform sample points as panel
-/// boundaries (a finer quadrature than the optimiser's as well).
+/// boundaries (a finer quadrature than the optimiser's as well), in the same angles' frame.
 pub fn fine_model(model: &Model, s_intervals: usize, gauss_points: usize) -> Model {
     let pts: Vec<f64> = (0..=s_intervals)
         .map(|j| j as f64 / s_intervals as f64)
         .collect();
-    Model::new(
+    let fine = Model::new(
         model.rod.clone(),
         model.layout,
         Discretisation {
@@ -26,7 +26,9 @@ pub fn fine_model(model: &Model, s_intervals: usize, gauss_points: usize) -> Mod
         model.base,
         model.loads.clone(),
         &pts,
-    )
+    );
+    fine.with_frame(model.frame())
+        .expect("the case's model took this frame")
 }
 
 /// Worst clearance to one obstacle.

@@ -410,6 +410,7 @@ fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
         end_pose: pose(p, &a, p.model.rod.length),
         points: c.report_points.iter().map(|&s| pose(p, &a, s)).collect(),
         coefficients: coefficients_json(p, &a),
+        angle_frame: p.model.angle_frame(),
         outer_iterations: None,
         timing_s: t0.elapsed().as_secs_f64(),
     };
