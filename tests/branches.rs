@@ -14,6 +14,11 @@ const CRITICAL: f64 = 8.986_818_916;
 
 /// The case with the straight rod twisted by `phi` as its explicit start, and `solver` settings.
 fn greenhill(phi: f64, pairs: usize, solver: &str) -> case::Case {
+    greenhill_in(phi, pairs, solver, "paper")
+}
+
+/// [`greenhill`] in the basis `basis`.
+fn greenhill_in(phi: f64, pairs: usize, solver: &str, basis: &str) -> case::Case {
     let nb = 2 + 2 * pairs;
     let zeros = vec![0.0; nb];
     let mut theta = zeros.clone();
@@ -24,7 +29,7 @@ fn greenhill(phi: f64, pairs: usize, solver: &str) -> case::Case {
     let panels = (4 * pairs).max(16);
     let text = format!(
         r#"{{"rod": {{"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0}},
-            "planar": false, "discretisation": {{"basis_pairs": {pairs}, "panels": {panels}}},
+            "planar": false, "discretisation": {{"basis_pairs": {pairs}, "panels": {panels}, "basis": "{basis}"}},
             "constraints": [
               {{"type": "orientation", "s": 0, "phi": 0, "theta": {h}, "psi": 0}},
               {{"type": "position", "s": 1.0, "y": 0, "z": 0}},
@@ -74,7 +79,16 @@ fn a_solve_started_on_a_stable_equilibrium_stays_on_it() {
 /// The verdict on the straight twisted rod, an equilibrium at every Φ (multipliers by least
 /// squares).
 fn verdict_of_straight(phi: f64, pairs: usize) -> (dlo_planner::stability::Stability, f64) {
-    let c = greenhill(phi, pairs, "");
+    verdict_of_straight_in(phi, pairs, "paper")
+}
+
+/// [`verdict_of_straight`] in the basis `basis`.
+fn verdict_of_straight_in(
+    phi: f64,
+    pairs: usize,
+    basis: &str,
+) -> (dlo_planner::stability::Stability, f64) {
+    let c = greenhill_in(phi, pairs, "", basis);
     let mut p = c.problem.clone();
     let a = c.initial.clone();
     let m = dlo_planner::optim::Nlp::m(&p);
@@ -128,6 +142,54 @@ fn the_verdict_changes_sign_at_greenhills_threshold() {
         assert_eq!(
             verdict_of_straight(threshold * 1.001, pairs).0.verdict,
             Verdict::Unstable
+        );
+    }
+}
+
+/// In the Legendre basis the threshold converges spectrally: the verdict's sign change lies
+/// 1.2e-3 above Greenhill's 8.9868 at 3 pairs (8 functions) and 8.5e-6 above it at 4 pairs
+/// (10; the paper's basis: 5 %), asserted within 2e-5; at 0.99 of the continuum's threshold
+/// the straight rod is stable and a solve with default settings started on it stays (energy
+/// to 1e-10, x(L) to 1e-9); at 1.01 it is unstable.
+#[test]
+fn legendre_basis_locates_greenhills_threshold() {
+    use dlo_planner::stability::Verdict;
+    for (pairs, tol) in [(4, 2e-5)] {
+        let (mut lo, mut hi) = (0.9 * CRITICAL, 1.2 * CRITICAL);
+        for _ in 0..50 {
+            let mid = 0.5 * (lo + hi);
+            let (s, kkt) = verdict_of_straight_in(mid, pairs, "legendre");
+            // Rounding of the least-squares multipliers: the polynomials' derivative rows
+            // reach k(k+1) at the ends, against 2πk for the paper's.
+            assert!(kkt < 1e-7, "the straight rod is an equilibrium: {kkt}");
+            if s.min_eigenvalue.unwrap() > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let threshold = 0.5 * (lo + hi);
+        eprintln!(
+            "legendre {pairs} pairs: threshold {threshold:.9} ({:+.3e} relative)",
+            threshold / CRITICAL - 1.0
+        );
+        assert!(
+            (threshold / CRITICAL - 1.0).abs() < tol,
+            "{pairs} pairs: {threshold}"
+        );
+        let below = verdict_of_straight_in(0.99 * CRITICAL, pairs, "legendre");
+        assert_eq!(below.0.verdict, Verdict::Stable);
+        let above = verdict_of_straight_in(1.01 * CRITICAL, pairs, "legendre");
+        assert_eq!(above.0.verdict, Verdict::Unstable);
+        let c = greenhill_in(0.99 * CRITICAL, pairs, "", "legendre");
+        let mut p = c.problem.clone();
+        let sol = solve_static(&mut p, &c.initial, &c.options);
+        let x = c.problem.model.evaluate(&sol.a).positions.last().unwrap()[0];
+        let u = sol.energy.flexural + sol.energy.torsional;
+        let straight = 0.5 * (0.99 * CRITICAL).powi(2);
+        assert!(
+            ((u - straight) / straight).abs() < 1e-10 && (x - 1.0).abs() < 1e-9,
+            "U = {u} (straight {straight}), x(L) = {x}"
         );
     }
 }

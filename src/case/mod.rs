@@ -110,6 +110,8 @@ pub struct RodSpec {
 pub struct DiscretisationSpec {
     /// Sine/cosine pairs per field (paper: 4, i.e. 10 functions).
     pub basis_pairs: usize,
+    /// The functions: `"paper"` (default) or `"legendre"`.
+    pub basis: crate::basis::BasisKind,
     /// Uniform quadrature panels.
     pub panels: usize,
     /// Gauss points per panel.
@@ -122,6 +124,7 @@ impl Default for DiscretisationSpec {
     fn default() -> Self {
         DiscretisationSpec {
             basis_pairs: 4,
+            basis: crate::basis::BasisKind::Paper,
             panels: 16,
             gauss_points: 4,
             samples: 32,
@@ -584,7 +587,8 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         basis: match s_split {
             Some(sa) => Basis::split_at(d.basis_pairs, v.arc("split", sa, l)?),
             None => Basis::new(d.basis_pairs),
-        },
+        }
+        .of_kind(d.basis),
         spatial: !file.planar,
         extensible: r.extensional_rigidity.is_some(),
         free_base: file.base.free,
