@@ -305,22 +305,17 @@ fn main() {
     let n_spatial = arg("--spatial", 30) as usize;
     let verbose = args.iter().any(|a| a == "--verbose");
     // `--plan '{"path_terms": 4}'`: planner settings given to every problem (to measure other
-    // settings on the same problems); none by default.
-    let plan: serde_json::Value = args
-        .iter()
-        .position(|a| a == "--plan")
-        .and_then(|i| args.get(i + 1))
-        .map_or(serde_json::json!({}), |t| {
-            serde_json::from_str(t).expect("--plan: a JSON object")
-        });
-    // `--case '{"angle_frame": "case"}'`: top-level case fields given to every problem.
-    let top: serde_json::Value = args
-        .iter()
-        .position(|a| a == "--case")
-        .and_then(|i| args.get(i + 1))
-        .map_or(serde_json::json!({}), |t| {
-            serde_json::from_str(t).expect("--case: a JSON object")
-        });
+    // settings on the same problems); `--case '{"angle_frame": "case"}'`: top-level case
+    // fields given to every problem; none by default.
+    let json_arg = |flag: &str| -> serde_json::Value {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .map_or(serde_json::json!({}), |t| {
+                serde_json::from_str(t).expect("a JSON object")
+            })
+    };
+    let (plan, top) = (json_arg("--plan"), json_arg("--case"));
     let mut rng = Rng(seed);
     let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut regenerated = [0usize; 2];

@@ -4,6 +4,17 @@ mod common;
 use common::*;
 use dlo_planner::statics::{StaticOptions, solve_static};
 
+/// The size of the force (x–z plane) the constraint `name` exerts on the rod.
+fn reaction(sol: &dlo_planner::statics::StaticSolution, name: &str) -> f64 {
+    let f = sol
+        .reactions
+        .iter()
+        .find(|r| r.constraint == name)
+        .unwrap()
+        .force;
+    (f[0] * f[0] + f[2] * f[2]).sqrt()
+}
+
 fn buckle(ratio: f64, pairs: usize) -> (f64, dlo_planner::statics::StaticSolution) {
     let mut p = pinned_problem(ratio, pairs);
     let mut a0 = vec![0.0; p.model.n()];
@@ -86,13 +97,7 @@ fn clamped_load_is_four_times_pinned() {
     let mut a0 = vec![0.0; p.model.n()];
     a0[2] = 0.1;
     let sol = solve_static(&mut p, &a0, &StaticOptions::default());
-    let f = sol
-        .reactions
-        .iter()
-        .find(|r| r.constraint == "end")
-        .unwrap()
-        .force;
-    let load = (f[0] * f[0] + f[2] * f[2]).sqrt();
+    let load = reaction(&sol, "end");
     eprintln!("clamped: {load:.6e} vs {exact:.6e}");
     assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
     assert!((load - exact).abs() / exact < 1e-3);
@@ -137,13 +142,7 @@ fn legendre_basis_converges_spectrally_on_the_pinned_elastica() {
             let mut c = dlo_planner::case::parse(&v.to_string(), &path).unwrap();
             let sol = solve_static(&mut c.problem, &c.initial, &c.options);
             assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
-            let f = sol
-                .reactions
-                .iter()
-                .find(|r| r.constraint == "right pin")
-                .unwrap()
-                .force;
-            let p = (f[0] * f[0] + f[2] * f[2]).sqrt();
+            let p = reaction(&sol, "right pin");
             let exact = pinned_elastica_load(ratio) / 1e4;
             let rel = (p - exact).abs() / exact;
             eprintln!("legendre {pairs} pairs, l/L = {ratio}: relative error {rel:.2e}");

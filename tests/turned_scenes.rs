@@ -156,14 +156,19 @@ fn assert_same(
     }
 }
 
+/// The cable of the report: 0.5 m, EI 0.01, GJ 0.008, 0.3 N/m.
+fn heavy_cable_rod() -> Value {
+    json!({ "length": 0.5, "flexural_rigidity": 0.01, "torsional_rigidity": 0.008,
+            "weight_per_length": 0.3, "radius": 0.002 })
+}
+
 /// The cable of the report: 0.5 m, EI 0.01, GJ 0.008, 0.3 N/m, clamped 0.3 m apart with the
 /// second end's tangent turned 90° about the vertical (x). Turned by any angle about x: the same
 /// energy and shape; its moment balance falls as the basis grows. In the case's own axes the
 /// same turns give energies from 0.18 to 2.2 J.
 #[test]
 fn heavy_cable_turned_about_the_vertical_is_the_same() {
-    let rod = json!({ "length": 0.5, "flexural_rigidity": 0.01, "torsional_rigidity": 0.008,
-                      "weight_per_length": 0.3, "radius": 0.002 });
+    let rod = heavy_cable_rod();
     let (f0, f1) = (
         frame([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
         frame([0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
@@ -398,8 +403,7 @@ fn a_plan_in_a_frame_reaches_the_written_poses() {
 /// paper's basis, 13 % in the case's axes).
 #[test]
 fn frame_and_legendre_basis_balance_3d_shapes() {
-    let rod = json!({ "length": 0.5, "flexural_rigidity": 0.01, "torsional_rigidity": 0.008,
-                      "weight_per_length": 0.3, "radius": 0.002 });
+    let rod = heavy_cable_rod();
     let (f0, f1) = (
         frame([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
         frame([0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
