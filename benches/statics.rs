@@ -11,10 +11,35 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn load(name: &str) -> case::Case {
+    load_with(name, serde_json::json!({}))
+}
+
+/// A shipped case with its top-level fields replaced by `fields`' (e.g. another
+/// `discretisation` or `angle_frame`).
+fn load_with(name: &str, fields: serde_json::Value) -> case::Case {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("planning_cases")
         .join(name);
-    case::load(&p).expect("shipped case loads")
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&p).expect("shipped case")).unwrap();
+    for (k, x) in fields.as_object().into_iter().flatten() {
+        v[k] = x.clone();
+    }
+    case::parse(&v.to_string(), &p).expect("shipped case loads")
+}
+
+/// Benchmarks `solve_static` of `c` from its own start, without the stability verdict.
+fn bench_solve(c: &mut Criterion, label: &str, case: &case::Case) {
+    let opts = StaticOptions {
+        stability: false,
+        ..case.options
+    };
+    c.bench_function(label, |b| {
+        b.iter(|| {
+            let mut p = case.problem.clone();
+            solve_static(&mut p, black_box(&case.initial), &opts)
+        })
+    });
 }
 
 fn benches(c: &mut Criterion) {
@@ -26,38 +51,40 @@ fn benches(c: &mut Criterion) {
     c.bench_function("planar energy+gradient (10 functions)", |b| {
         b.iter(|| m.objective_and_gradient(black_box(&a), Objective::Internal, &mut shape, &mut g))
     });
-    let no_stab = StaticOptions {
-        stability: false,
-        ..pinned.options
-    };
-    c.bench_function("planar pinned buckling solve (l = 0.8L)", |b| {
-        b.iter(|| {
-            let mut p = pinned.problem.clone();
-            solve_static(&mut p, black_box(&pinned.initial), &no_stab)
-        })
-    });
-    let twist = load("kinking_twist_2pi_080.json");
-    let opts = StaticOptions {
-        stability: false,
-        ..twist.options
-    };
-    c.bench_function("3D twisted clamped solve (30 coefficients)", |b| {
-        b.iter(|| {
-            let mut p = twist.problem.clone();
-            solve_static(&mut p, black_box(&twist.initial), &opts)
-        })
-    });
-    let ext = load("extensible_twist_3d.json");
-    let opts = StaticOptions {
-        stability: false,
-        ..ext.options
-    };
-    c.bench_function("3D extensible twisted solve (40 coefficients)", |b| {
-        b.iter(|| {
-            let mut p = ext.problem.clone();
-            solve_static(&mut p, black_box(&ext.initial), &opts)
-        })
-    });
+    bench_solve(c, "planar pinned buckling solve (l = 0.8L)", &pinned);
+    let legendre = serde_json::json!({ "discretisation": { "basis": "legendre" } });
+    bench_solve(
+        c,
+        "planar pinned buckling solve, Legendre basis (l = 0.8L)",
+        &load_with("pinned_buckling_080.json", legendre),
+    );
+    bench_solve(
+        c,
+        "3D twisted clamped solve (30 coefficients)",
+        &load("kinking_twist_2pi_080.json"),
+    );
+    bench_solve(
+        c,
+        "3D extensible twisted solve (40 coefficients)",
+        &load("extensible_twist_3d.json"),
+    );
+    let case_axes = serde_json::json!({ "angle_frame": "case" });
+    bench_solve(
+        c,
+        "3D extensible twisted solve, the case's axes (40 coefficients)",
+        &load_with("extensible_twist_3d.json", case_axes),
+    );
+    let case_axes = serde_json::json!({ "angle_frame": "case" });
+    bench_solve(
+        c,
+        "3D crossed loop with self-contact, the case's axes",
+        &load_with("self_contact_crossed_loop.json", case_axes),
+    );
+    bench_solve(
+        c,
+        "3D crossed loop with self-contact",
+        &load("self_contact_crossed_loop.json"),
+    );
 }
 
 criterion_group! {
