@@ -232,6 +232,39 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             )),
             "forces[0].force[1]",
         ),
+        (
+            "unknown angle frame",
+            c(&format!(r#"{GOOD_ROD}, "angle_frame": "sideways""#)),
+            "angle_frame: expected \"auto\", \"case\" or a 3×3 rotation matrix",
+        ),
+        (
+            "angle frame not a rotation",
+            c(
+                r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0}, "planar": false, "angle_frame": [[1, 0, 0], [0, 1, 0], [0, 0, 2]]"#,
+            ),
+            "field `angle_frame`: must be a rotation matrix",
+        ),
+        (
+            "angle frame on a planar rod",
+            c(&format!(
+                r#"{GOOD_ROD}, "angle_frame": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]"#
+            )),
+            "field `angle_frame`: a planar rod's angles",
+        ),
+        (
+            "angle frame with a partial orientation",
+            c(
+                r#""rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 1.0}, "planar": false, "angle_frame": [[0, 0, 1], [1, 0, 0], [0, 1, 0]], "constraints": [{"type": "orientation", "s": 0.0, "psi": 0.3}]"#,
+            ),
+            "constraints[0] prescribes angles that cannot be measured from another frame",
+        ),
+        (
+            "unknown basis",
+            c(&format!(
+                r#"{GOOD_ROD}, "discretisation": {{"basis": "chebyshev"}}"#
+            )),
+            "unknown variant `chebyshev`, expected `paper` or `legendre`",
+        ),
     ]
 }
 

@@ -61,13 +61,30 @@ impl AngleFrame {
 /// The case file's `angle_frame`: a name, or the frame itself as a reports gives it (a
 /// row-major rotation whose columns are the angles' axes in the case's), so that coefficients
 /// copied from a report describe the same shape.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
-#[serde(untagged)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AngleFrameSpec {
     /// `"auto"` or `"case"`.
     Named(AngleFrame),
     /// An explicit frame.
     Matrix([[f64; 3]; 3]),
+}
+
+impl<'de> serde::Deserialize<'de> for AngleFrameSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = serde_json::Value::deserialize(d)?;
+        match v.as_str() {
+            Some("auto") => return Ok(AngleFrameSpec::Named(AngleFrame::Auto)),
+            Some("case") => return Ok(AngleFrameSpec::Named(AngleFrame::Case)),
+            _ => {}
+        }
+        serde_json::from_value::<[[f64; 3]; 3]>(v)
+            .map(AngleFrameSpec::Matrix)
+            .map_err(|_| {
+                serde::de::Error::custom(
+                    "angle_frame: expected \"auto\", \"case\" or a 3×3 rotation matrix (three rows of three numbers)",
+                )
+            })
+    }
 }
 
 /// An orientation the case prescribes, in its own axes.
