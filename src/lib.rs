@@ -12,7 +12,9 @@
 //! and reports reaction forces and stability. [`path`] and [`planner`] plan deformation paths
 //! (§7) and replay them by the controlled end. [`case`] reads case files.
 //!
-//! The library prints nothing.
+//! The library prints nothing. Its default feature `cli` builds the `dlo` tool and with it
+//! `mcap` ([`mcap_log`]: MCAP logs for Foxglove) and `plot` ([`plot`]: SVG pictures of logs); a
+//! library user who needs neither depends on it with `default-features = false`.
 
 pub mod balance;
 pub mod basis;
@@ -24,6 +26,7 @@ pub mod grasp;
 pub mod hessian;
 pub mod kinematics;
 pub mod layout;
+#[cfg(feature = "mcap")]
 pub mod mcap_log;
 pub mod mesh;
 pub mod model;
@@ -31,6 +34,7 @@ pub mod obstacle;
 pub mod optim;
 pub mod path;
 pub mod planner;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod problem;
 pub mod quadrature;
