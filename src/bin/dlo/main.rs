@@ -501,6 +501,13 @@ fn print_report(r: &ShapeReport, json: bool) {
             c.s[1]
         );
     }
+    if let Some(f) = r.angle_frame {
+        let _ = writeln!(
+            o,
+            "  angles measured from a frame whose pole points along [{:+.4}, {:+.4}, {:+.4}] (angle_frame; coefficients are in it)",
+            f[0][2], f[1][2], f[2][2]
+        );
+    }
     for p in &r.points {
         let _ = writeln!(
             o,
