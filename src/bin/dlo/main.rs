@@ -685,14 +685,15 @@ fn run_plan(
         (PlanStatus::Collision, _) if result.min_clearance.is_none_or(|c| c >= 0.0) => {
             let (gap, k) = result.verification.self_contact.unwrap_or((0.0, 0.0));
             eprintln!(
-                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3})",
-                path.display()
+                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}); {}",
+                path.display(),
+                TRY_COLLISION
             );
             ExitCode::from(EXIT_COLLISION)
         }
         (PlanStatus::Collision, _) => {
             eprintln!(
-                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4})",
+                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}); {}",
                 path.display(),
                 result.min_clearance.unwrap_or(0.0),
                 result
@@ -713,6 +714,7 @@ fn run_plan(
                     .iter()
                     .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
                     .map_or(0.0, |o| o.s),
+                TRY_COLLISION
             );
             ExitCode::from(EXIT_COLLISION)
         }
@@ -727,7 +729,7 @@ fn run_plan(
         }
         (PlanStatus::Planned, false) => {
             eprintln!(
-                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}",
+                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}; {}",
                 path.display(),
                 result.replay.max_deviation_over_l,
                 result.replay.k_at_max_deviation,
@@ -736,13 +738,20 @@ fn run_plan(
                     String::new()
                 } else {
                     format!(", snap-through at k = {}", snap_list(&result.replay.snaps))
-                }
+                },
+                TRY_DEPARTURE
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
         }
         (PlanStatus::Planned, true) => ExitCode::SUCCESS,
     }
 }
+
+/// What to try when no plan is collision-free (the case file's `plan` fields).
+const TRY_COLLISION: &str = "try plan.swept_clearance: true, more plan.k_samples, more path terms (plan.fallback_path_terms, e.g. [6, 8]) or more plan.starts";
+
+/// What to try when the replay departs from the plan.
+const TRY_DEPARTURE: &str = "try more path terms (plan.fallback_path_terms, e.g. [6, 8]), more plan.starts, or a stronger plan.equilibrium_weight; the replayed path in the log is what the controlled end does";
 
 fn plan_summary(r: &PlanReport) -> String {
     use std::fmt::Write;
