@@ -14,7 +14,7 @@
 //! where the rod's tangent passes through ±z between its ends (θ = 0 or π, where φ and ψ enter
 //! only as φ ∓ ψ): the parametrisation holds the tangent at the pole like a hidden support.
 
-use crate::kinematics::Shape;
+use crate::kinematics::{Shape, cross};
 use crate::problem::StaticProblem;
 use crate::statics::{Reaction, point_forces};
 use serde::Serialize;
@@ -31,14 +31,6 @@ pub struct Balance {
     /// least `10⁻³ · |F| · L` for the largest force `F` and `10⁻¹² · Rf/L`, so that a rod loaded
     /// only along its supports' arms, or not at all, gives rounding, not 1.
     pub relative: f64,
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn norm(v: [f64; 3]) -> f64 {

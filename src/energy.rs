@@ -100,6 +100,7 @@ impl Model {
         if quadratic {
             self.quadratic_terms(a, &mut t, grad.as_deref_mut());
         }
+        let up = self.up();
         // The node sums below, unless the quadratic form has already given them.
         let nodes = if quadratic { 0 } else { self.nodes() };
         for q in 0..nodes {
@@ -115,31 +116,30 @@ impl Model {
             if oe.is_some() {
                 t.extensional += 0.5 * we * eps * eps;
             }
-            // The tangent's height `ζ·x̂`, and its θ and φ derivatives: `sθcφ` in the case's
-            // axes; `u·ζ` for the vertical `u` of an angles' frame.
-            let (up, up_th, up_ph) = match self.up {
-                None => (st * cp, ct * cp, -st * sp),
-                Some(u) => (
-                    u[0] * st * cp + u[1] * st * sp + u[2] * ct,
-                    u[0] * ct * cp + u[1] * ct * sp - u[2] * st,
-                    -u[0] * st * sp + u[1] * st * cp,
+            // Gravity `wg (1+ε) h` for the tangent's height `h = ζ·x̂` (`sθcφ` in the case's
+            // axes, `u·ζ` for the vertical `u` of an angles' frame): its value and its θ, φ
+            // and ε derivatives.
+            let (grav, grav_th, grav_ph, grav_e) = match up {
+                None => (
+                    wg * one * st * cp,
+                    wg * one * ct * cp,
+                    -wg * one * st * sp,
+                    wg * st * cp,
                 ),
+                Some(u) => {
+                    let h = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
+                    let h_th = u[0] * ct * cp + u[1] * ct * sp - u[2] * st;
+                    let h_ph = -u[0] * st * sp + u[1] * st * cp;
+                    (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
+                }
             };
-            if self.up.is_none() {
-                t.gravitational += wg * one * st * cp;
-            } else {
-                t.gravitational += wg * one * up;
-            }
+            t.gravitational += grav;
             let Some(g) = grad.as_deref_mut() else {
                 continue;
             };
             let (e, de) = (self.e_at(q), self.de_at(q));
             // d/dθ (value) and d/dθ' terms
-            let mut g_th = if self.up.is_none() {
-                wg * one * ct * cp
-            } else {
-                wg * one * up_th
-            };
+            let mut g_th = grav_th;
             let g_dth = wf * dth;
             if spatial {
                 g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
@@ -148,11 +148,7 @@ impl Model {
                 g[i] += g_th * e[i] + g_dth * de[i];
             }
             if let (Some(op), Some(ops)) = (op, ops) {
-                let g_ph = if self.up.is_none() {
-                    -wg * one * st * sp
-                } else {
-                    wg * one * up_ph
-                };
+                let g_ph = grav_ph;
                 let g_dph = wf * dph * st * st + wt * omega * ct;
                 let g_dps = wt * omega;
                 for i in 0..nb {
@@ -161,11 +157,7 @@ impl Model {
                 }
             }
             if let Some(oe) = oe {
-                let g_e = if self.up.is_none() {
-                    we * eps + wg * st * cp
-                } else {
-                    we * eps + wg * up
-                };
+                let g_e = we * eps + grav_e;
                 for i in 0..nb {
                     g[oe + i] += g_e * e[i];
                 }

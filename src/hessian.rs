@@ -120,6 +120,7 @@ impl Model {
         // is zero, and the assembly would skip them all.
         let quadratic = !self.energy_roots.is_empty();
         if !quadratic {
+            let up = self.up();
             self.assemble_local(h, |q, hq| {
                 let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
                 let (dph, dps, _eps) = (shape.dph[q], shape.dps[q], shape.eps[q]);
@@ -127,7 +128,7 @@ impl Model {
                 let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
                 let omega = dph * ct + dps;
                 // Gravity: wg (1+ε) sθ cφ; wg (1+ε) u·ζ for the vertical `u` of an angles' frame.
-                if let Some(u) = self.up {
+                if let Some(u) = up {
                     let f = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
                     hq[TH][TH] = -wg * one * f;
                     hq[TH][PH] = wg * one * (-u[0] * ct * sp + u[1] * ct * cp);

@@ -504,6 +504,29 @@ fn evaluate_fields_body(m: &Model, a: &[f64], shape: &mut Shape) -> bool {
     false
 }
 
+/// `a × b`.
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Whether `r` (row-major) is a proper rotation: orthonormal columns to `tol` and determinant
+/// positive (false for any non-finite entry).
+pub(crate) fn is_rotation(r: [[f64; 3]; 3], tol: f64) -> bool {
+    let ortho = (0..3).all(|i| {
+        (0..3).all(|j| {
+            let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
+            (d - f64::from(u8::from(i == j))).abs() < tol
+        })
+    });
+    let col = |j: usize| [r[0][j], r[1][j], r[2][j]];
+    let det: f64 = (0..3).map(|k| cross(col(0), col(1))[k] * col(2)[k]).sum();
+    ortho && det > 0.0
+}
+
 /// Euler angles `(φ, θ, ψ)` of the rotation `m` (row-major) with `θ ∈ [0, π]`, `φ, ψ ∈ (−π, π]`
 /// (at the poles, where only `φ ± ψ` is defined, `φ = 0`).
 pub fn angles_of(m: [[f64; 3]; 3]) -> [f64; 3] {

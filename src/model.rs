@@ -103,8 +103,6 @@ pub struct Model {
     /// `R A(φ, θ, ψ)` and positions are `x(0) + R ∫ (1+ε) ζ`, so the ZYZ pole (`θ = 0, π`)
     /// lies along `R ẑ`. `None` is the identity (the case's own axes, as in the paper).
     pub(crate) frame: Option<[[f64; 3]; 3]>,
-    /// With a frame, the vertical `x̂` in the angles' frame (`Rᵀ x̂`), which gravity reads.
-    pub(crate) up: Option<[f64; 3]>,
 }
 
 /// One square-root row of the constant energy Hessian: `√λ v` for an eigenpair `(λ, v)` of its
@@ -177,7 +175,6 @@ impl Model {
             constant_hessian: Vec::new(),
             energy_roots: Vec::new(),
             frame: None,
-            up: None,
         };
         model.constant_hessian = model.assemble_constant_hessian();
         if !model.layout.spatial && model.gravity_total == 0.0 && model.wg.iter().all(|&w| w == 0.0)
@@ -219,30 +216,19 @@ impl Model {
     /// then describe `Rᵀ` times the case's frames, and the ZYZ pole lies along `R ẑ`. Only a
     /// 3D rod can take one other than the identity; `None` if `R` is refused.
     pub fn with_frame(mut self, r: [[f64; 3]; 3]) -> Option<Model> {
-        let ortho = (0..3).all(|i| {
-            (0..3).all(|j| {
-                let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
-                (d - f64::from(u8::from(i == j))).abs() < 1e-12
-            })
-        });
-        let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
-            - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-            + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
         let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
-        if !ortho || det <= 0.0 || !(self.layout.spatial || identity) {
+        if !crate::kinematics::is_rotation(r, 1e-12) || !(self.layout.spatial || identity) {
             return None;
         }
         self.frame = (!identity).then_some(r);
-        // The vertical in the angles' frame: `Rᵀ x̂`, the first row of R.
-        self.up = self.frame.map(|r| r[0]);
         Some(self)
     }
 
-    /// The angles' reference frame `R` (row-major; the identity unless
-    /// [`Model::with_frame`] set another).
-    pub fn frame(&self) -> [[f64; 3]; 3] {
-        self.frame
-            .unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    /// With a frame, the vertical `x̂` in the angles' frame, `Rᵀ x̂` (the first row of R),
+    /// which gravity reads.
+    #[inline]
+    pub(crate) fn up(&self) -> Option<[f64; 3]> {
+        self.frame.map(|r| r[0])
     }
 
     /// The angles' reference frame `R` if it is not the identity.

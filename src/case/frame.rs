@@ -27,12 +27,12 @@
 
 use super::{CaseFile, ConstraintSpec};
 use crate::constraints::Angle;
-use crate::kinematics::{angles_of, rotation};
+use crate::kinematics::{angles_of, cross, is_rotation, rotation};
 use crate::layout::Field;
+use crate::model::Model;
+use crate::planner::orientation::{Matrix, nearest};
 use crate::planner::spec::{EndSpec, EulerBranch};
-use std::f64::consts::{PI, TAU};
-
-type Matrix = [[f64; 3]; 3];
+use std::f64::consts::PI;
 
 /// How a case's 3D angles are measured (the case file's `angle_frame`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
@@ -141,16 +141,7 @@ pub(crate) fn choose(file: &CaseFile) -> Result<Option<Matrix>, String> {
     if file.planar {
         return Err("a planar rod's angles are measured in the case's axes: remove it".into());
     }
-    let ortho = (0..3).all(|i| {
-        (0..3).all(|j| {
-            let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
-            d.is_finite() && (d - f64::from(u8::from(i == j))).abs() < 1e-9
-        })
-    });
-    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
-        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-    if !ortho || det <= 0.0 {
+    if !is_rotation(r, 1e-9) {
         return Err("must be a rotation matrix (rows, orthonormal to 1e-9, determinant +1)".into());
     }
     for (i, c) in file.constraints.iter().enumerate() {
@@ -442,7 +433,7 @@ fn farthest_on_sphere(lines: &[([f64; 3], f64)]) -> [f64; 3] {
 /// The case's orientation constraints as rows on the angles of `r` (see the module
 /// documentation), in the order of `file.constraints`; `None` for one that is not an
 /// orientation.
-pub(crate) fn convert(file: &CaseFile, r: &Matrix) -> Vec<Option<Vec<(Angle, f64)>>> {
+pub(crate) fn convert(file: &CaseFile, model: &Model) -> Vec<Option<Vec<(Angle, f64)>>> {
     let mut order: Vec<(usize, f64, Written)> = file
         .constraints
         .iter()
@@ -452,10 +443,7 @@ pub(crate) fn convert(file: &CaseFile, r: &Matrix) -> Vec<Option<Vec<(Angle, f64
         .collect();
     order.sort_by(|a, b| a.1.total_cmp(&b.1));
     let mut out = vec![None; file.constraints.len()];
-    let local = |angles: [f64; 3]| -> Matrix {
-        let m = rotation(angles[0], angles[1], angles[2]);
-        std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| r[k][i] * m[k][j]).sum()))
-    };
+    let local = |a: [f64; 3]| model.rotation_to_angles(rotation(a[0], a[1], a[2]));
     // The written angles (ψ filled in from the previous where a tangent leaves it) and their
     // angles in `r`, of the previous constraint.
     let mut prev: Option<([f64; 3], [f64; 3])> = None;
@@ -498,9 +486,8 @@ pub(crate) fn convert(file: &CaseFile, r: &Matrix) -> Vec<Option<Vec<(Angle, f64
 /// The spelling of the rotation with angles `a` — `(φ, θ, ψ)` or `(φ + π, −θ, ψ + π)`, each
 /// angle plus any multiple of 2π — nearest `reference`.
 fn nearest_branch(a: [f64; 3], reference: [f64; 3]) -> [f64; 3] {
-    let near = |x: f64, t: f64| x + TAU * ((t - x) / TAU).round();
     [a, [a[0] + PI, -a[1], a[2] + PI]]
-        .map(|b| std::array::from_fn::<f64, 3, _>(|j| near(b[j], reference[j])))
+        .map(|b| std::array::from_fn::<f64, 3, _>(|j| nearest(b[j], reference[j])))
         .into_iter()
         .min_by(|x, y| dist(*x, reference).total_cmp(&dist(*y, reference)))
         .expect("two spellings")
@@ -516,14 +503,6 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn unit(v: [f64; 3]) -> Option<[f64; 3]> {

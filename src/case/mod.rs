@@ -659,7 +659,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
     let angle_frame = frame::choose(&file).map_err(|m| v.err("angle_frame", m))?;
     let (model, converted) = match angle_frame.and_then(|r| model.clone().with_frame(r)) {
         Some(m) => {
-            let rows = frame::convert(&file, &m.frame());
+            let rows = frame::convert(&file, &m);
             (m, Some(rows))
         }
         None => (model, None),

@@ -14,7 +14,7 @@
 //! The reference is the held end's frame for the start and the start shape's end for the goal,
 //! so equivalent spellings of a pose give the same angles and the same plan.
 
-use crate::kinematics::rotation;
+use crate::kinematics::{angles_of, rotation};
 use std::f64::consts::{PI, TAU};
 
 /// A rotation matrix (row-major).
@@ -35,20 +35,15 @@ pub fn tangent_twist(tangent: [f64; 3], twist: f64) -> Matrix {
     rotation(phi, theta, twist - phi)
 }
 
-/// Euler angles of `m` with `θ ∈ [0, π]` (at the poles, `φ = 0`).
-fn principal(m: Matrix) -> [f64; 3] {
-    crate::kinematics::angles_of(m)
-}
-
 /// `x + 2πn` nearest `target`.
-fn nearest(x: f64, target: f64) -> f64 {
+pub(crate) fn nearest(x: f64, target: f64) -> f64 {
     x + TAU * ((target - x) / TAU).round()
 }
 
 /// The Euler angles of `m` in the branch described in the module documentation, continuing
 /// from `reference` (its `(φ, θ, ψ)`); `written_phi` is the `φ` the user wrote, if any.
 pub fn euler_branch(m: Matrix, reference: [f64; 3], written_phi: Option<f64>) -> [f64; 3] {
-    let [f0, t0, p0] = principal(m);
+    let [f0, t0, p0] = angles_of(m);
     let [rf, rt, rp] = reference;
     // 1. θ's sign.
     let (f, theta, p) = if t0 > 0.0 && (-t0 - rt).abs() < (t0 - rt).abs() - 1e-12 {

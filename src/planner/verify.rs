@@ -27,8 +27,12 @@ pub fn fine_model(model: &Model, s_intervals: usize, gauss_points: usize) -> Mod
         model.loads.clone(),
         &pts,
     );
-    fine.with_frame(model.frame())
-        .expect("the case's model took this frame")
+    match model.angle_frame() {
+        Some(r) => fine
+            .with_frame(r)
+            .expect("the case's model took this frame"),
+        None => fine,
+    }
 }
 
 /// Worst clearance to one obstacle.
