@@ -4,9 +4,7 @@
 //! the baseline path. On a processor without AVX2 both runs take the baseline path and the test
 //! checks nothing more than reproducibility.
 
-mod common;
-
-use common::strip;
+use crate::common::strip;
 use std::path::Path;
 use std::process::Command;
 

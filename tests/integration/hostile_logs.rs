@@ -7,6 +7,7 @@
 //! Runs for `DLO_FUZZ_SECONDS` (the two generated tests share it; default 8 s, `.ci/run` gives more) in batches of proptest
 //! cases from fixed seeds, so a failure names the batch that reproduces it.
 
+use crate::common;
 use dlo_planner::mcap_log::inspect::inspect;
 use dlo_planner::mcap_log::reader::check_finished;
 use dlo_planner::mcap_log::recover::recover;
@@ -14,8 +15,6 @@ use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
-
-mod common;
 
 /// A real log: `dlo` run on a shipped case into a folder of this test's own.
 fn log_of(command: &str, case: &str) -> Vec<u8> {

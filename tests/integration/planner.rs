@@ -3,9 +3,7 @@
 //! paths, the replay's agreement with the plan where it holds, and a negative verdict where
 //! one end cannot suffice.
 
-mod common;
-
-use common::shipped_variant;
+use crate::common::{self, shipped_variant};
 use dlo_planner::case;
 use dlo_planner::path::DeformationPath;
 use dlo_planner::planner::observer::Silent;

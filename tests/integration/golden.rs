@@ -7,9 +7,7 @@
 //!
 //! and the diff of `tests/golden/` is reviewed with it.
 
-mod common;
-
-use common::strip;
+use crate::common::strip;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -1,7 +1,6 @@
 //! Pinned–pinned compression against the closed-form elastica (complete elliptic integrals).
 
-mod common;
-use common::*;
+use crate::common::*;
 use dlo_planner::statics::{StaticOptions, solve_static};
 
 /// The size of the force (x–z plane) the constraint `name` exerts on the rod.

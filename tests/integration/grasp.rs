@@ -1,8 +1,7 @@
 //! Grasp stability (paper §6.2): initial grasping forces against the closed-form elastica, the
 //! paper's Fig. 14 findings, Fig. 15's trends, and the split basis's gradients.
 
-mod common;
-
+use crate::common;
 use dlo_planner::grasp::Grasp;
 use dlo_planner::optim::Nlp;
 use std::f64::consts::FRAC_1_SQRT_2 as H;

@@ -1,7 +1,7 @@
 //! Finite-difference checks of every energy term's gradient and every constraint kind's
 //! Jacobian, on random coefficients, planar and 3D (the contract every constraint must pass).
 
-mod common;
+use crate::common;
 use dlo_planner::basis::Basis;
 use dlo_planner::constraints::*;
 use dlo_planner::energy::Objective;
@@ -301,7 +301,7 @@ fn obstacle(name: &str, shape: ObstacleShape, position: [f64; 3]) -> Arc<Obstacl
 fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
     let v = |x: f64, y: f64, z: f64| Vector::new(x, y, z);
     let spatial = m.layout.spatial;
-    let (verts, faces) = read_obj(include_str!("../planning_cases/meshes/cube.obj")).unwrap();
+    let (verts, faces) = read_obj(include_str!("../../planning_cases/meshes/cube.obj")).unwrap();
     let mesh = TriMesh::with_flags(
         verts
             .iter()
@@ -486,7 +486,7 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
     assert!((h.signed_distance([0.0, 0.0, 1.3]).0 - 0.5).abs() < 1e-12);
     assert!((h.signed_distance([5.0, 1.0, 0.3]).0 + 0.5).abs() < 1e-12);
     // A point deep inside a closed oriented mesh is recognised as inside.
-    let (verts, faces) = read_obj(include_str!("../planning_cases/meshes/cube.obj")).unwrap();
+    let (verts, faces) = read_obj(include_str!("../../planning_cases/meshes/cube.obj")).unwrap();
     let mesh = TriMesh::with_flags(
         verts
             .iter()

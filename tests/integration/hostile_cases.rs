@@ -7,13 +7,12 @@
 //! Runs for `DLO_FUZZ_SECONDS` (default 8 s; `.ci/run` gives it more) in batches of proptest
 //! cases from fixed seeds.
 
+use crate::common;
 use dlo_planner::case;
 use proptest::prelude::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-mod common;
 
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 

@@ -2,7 +2,7 @@
 //! energy, the equilibrium-tracking term and the sampled path constraints, all chained through
 //! the path parameterisation and the null space of the fixed conditions.
 
-mod common;
+use crate::common;
 use dlo_planner::case;
 use dlo_planner::optim::Nlp;
 use dlo_planner::planner::Planner;

@@ -1,0 +1,23 @@
+//! The integration tests, one module per subject, linked into one test binary (one link
+//! instead of one per file). Run one subject with `cargo test --release --test integration
+//! golden::`.
+
+mod balance;
+mod branches;
+mod clear_samples;
+mod cli_errors;
+mod common;
+mod elastica;
+mod golden;
+mod gradients;
+mod grasp;
+mod hostile_cases;
+mod hostile_logs;
+mod invariants;
+mod mcap_log;
+mod paper_claims;
+mod planner;
+mod planner_gradients;
+mod self_contact;
+mod turned_scenes;
+mod wide_kernels;
