@@ -78,7 +78,7 @@ pub fn balance(
     // conditions join the pieces of a split basis.
     for (k, con) in p.constraints.iter().enumerate() {
         let lam = &lambda[p.rows_of(k)];
-        for (b, f, reported) in point_forces(m, shape, con.as_ref(), lam).unwrap_or_default() {
+        for (b, f, reported) in point_forces(m, shape, con, lam).unwrap_or_default() {
             add(cross(arm(at(b)), f), f, reported);
         }
     }

@@ -13,7 +13,7 @@ pub struct StaticProblem {
     /// The rod model.
     pub model: Model,
     /// Constraint blocks, in case-file order.
-    pub constraints: Vec<Box<dyn Constraint>>,
+    pub constraints: Vec<Constraint>,
     /// Which energy is minimised.
     pub objective: Objective,
     offsets: Vec<usize>,
@@ -26,7 +26,7 @@ pub struct StaticProblem {
 
 impl StaticProblem {
     /// Assembles a problem.
-    pub fn new(model: Model, constraints: Vec<Box<dyn Constraint>>) -> Self {
+    pub fn new(model: Model, constraints: Vec<Constraint>) -> Self {
         let mut offsets = vec![0];
         let mut senses = Vec::new();
         for c in &constraints {
@@ -129,8 +129,7 @@ impl Nlp for StaticProblem {
     }
     fn hessian_is_exact(&self, y: &[f64]) -> bool {
         self.constraints.iter().enumerate().all(|(k, con)| {
-            !con.as_any()
-                .is::<crate::constraints::SelfContactConstraint>()
+            !matches!(con, Constraint::SelfContact(_))
                 || y[self.offsets[k]..self.offsets[k + 1]]
                     .iter()
                     .all(|v| *v == 0.0)

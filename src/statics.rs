@@ -65,7 +65,7 @@ pub fn self_contacts(p: &StaticProblem, shape: &Shape, lambda: &[f64]) -> Vec<Se
     let (l, fu) = (m.rod.length, m.rod.force_unit());
     let mut out = Vec::new();
     for (k, con) in p.constraints.iter().enumerate() {
-        if let Some(sc) = downcast::<crate::constraints::SelfContactConstraint>(con.as_ref()) {
+        if let crate::constraints::Constraint::SelfContact(sc) = con {
             for (t, f) in sc.contacts(m, shape, &lambda[p.rows_of(k)]) {
                 out.push(SelfContactForce {
                     s: t.map(|v| v * l),
@@ -190,40 +190,43 @@ fn finish(
 pub(crate) fn point_forces(
     m: &crate::model::Model,
     shape: &Shape,
-    con: &dyn crate::constraints::Constraint,
+    con: &crate::constraints::Constraint,
     lam: &[f64],
 ) -> Option<Vec<(usize, [f64; 3], bool)>> {
     use crate::constraints::*;
     let (fu, l) = (m.rod.force_unit(), m.rod.length);
-    if let Some(pc) = downcast::<PositionConstraint>(con) {
-        let mut f = [0.0; 3];
-        for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
-            let sign = if matches!(b, Bound::AtLeast(_)) {
-                1.0
-            } else {
-                -1.0
-            };
-            f[comp] += sign * li * fu;
-        }
-        Some(vec![(pc.boundary, f, true)])
-    } else if let Some(rc) = downcast::<RelativePositionConstraint>(con) {
-        let mut f = [0.0; 3];
-        for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
-            f[comp] -= li * fu;
-        }
-        Some(vec![(rc.to, f, true), (rc.from, f.map(|v| -v), false)])
-    } else if let Some(ob) = downcast::<ObstacleConstraint>(con) {
-        let mut out = Vec::new();
-        for (&li, &b) in lam.iter().zip(&ob.samples) {
-            if li > 0.0 {
-                let x = shape.positions[b].map(|v| v * l);
-                let (_, n) = ob.obstacle.signed_distance(x);
-                out.push((b, n.map(|nc| li * nc * fu), true));
+    match con {
+        Constraint::Position(pc) => {
+            let mut f = [0.0; 3];
+            for (&li, &(comp, b)) in lam.iter().zip(&pc.rows) {
+                let sign = if matches!(b, Bound::AtLeast(_)) {
+                    1.0
+                } else {
+                    -1.0
+                };
+                f[comp] += sign * li * fu;
             }
+            Some(vec![(pc.boundary, f, true)])
         }
-        Some(out)
-    } else {
-        None
+        Constraint::RelativePosition(rc) => {
+            let mut f = [0.0; 3];
+            for (&li, &(comp, _)) in lam.iter().zip(&rc.rows) {
+                f[comp] -= li * fu;
+            }
+            Some(vec![(rc.to, f, true), (rc.from, f.map(|v| -v), false)])
+        }
+        Constraint::Obstacle(ob) => {
+            let mut out = Vec::new();
+            for (&li, &b) in lam.iter().zip(&ob.samples) {
+                if li > 0.0 {
+                    let x = shape.positions[b].map(|v| v * l);
+                    let (_, n) = ob.obstacle.signed_distance(x);
+                    out.push((b, n.map(|nc| li * nc * fu), true));
+                }
+            }
+            Some(out)
+        }
+        Constraint::Orientation(_) | Constraint::Linear(_) | Constraint::SelfContact(_) => None,
     }
 }
 
@@ -246,9 +249,9 @@ pub fn reactions(p: &StaticProblem, a: &[f64], shape: &Shape, lambda: &[f64]) ->
             moment: [0.0; 3],
             angle_torques: [0.0; 3],
         };
-        if let Some(forces) = point_forces(m, shape, con.as_ref(), lam) {
+        if let Some(forces) = point_forces(m, shape, con, lam) {
             // A single point's reaction says where it acts; an obstacle's is its total.
-            let at_point = downcast::<ObstacleConstraint>(con.as_ref()).is_none();
+            let at_point = !matches!(con, Constraint::Obstacle(_));
             if let (true, Some(&(b, _, _))) = (at_point, forces.first()) {
                 r.s = Some(m.mesh.boundaries[b] * l);
             }
@@ -257,7 +260,7 @@ pub fn reactions(p: &StaticProblem, a: &[f64], shape: &Shape, lambda: &[f64]) ->
                     *rc += fc;
                 }
             }
-        } else if let Some(oc) = downcast::<OrientationConstraint>(con.as_ref()) {
+        } else if let Constraint::Orientation(oc) = con {
             r.s = Some(oc.t * l);
             // Generalized torques conjugate to each prescribed angle row; a φ+ψ row acts on
             // both (its torque is about z = ζ where θ = 0).
@@ -307,10 +310,6 @@ pub fn reactions(p: &StaticProblem, a: &[f64], shape: &Shape, lambda: &[f64]) ->
         );
     }
     out
-}
-
-fn downcast<T: 'static>(c: &dyn crate::constraints::Constraint) -> Option<&T> {
-    c.as_any().downcast_ref::<T>()
 }
 
 /// Minimum-norm moment `M` with `M·z = τ_φ`, `M·(Rz(φ)ŷ) = τ_θ`, `M·ζ = τ_ψ` for the prescribed

@@ -665,7 +665,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         None => (model, None),
     };
 
-    let mut constraints: Vec<Box<dyn Constraint>> = Vec::new();
+    let mut constraints: Vec<Constraint> = Vec::new();
     // Fixed points for the reachability check: (t, position, all components fixed).
     let mut fixed: Vec<(f64, [f64; 3])> = Vec::new();
     if !file.base.free {
@@ -735,7 +735,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 if all_fixed {
                     fixed.push((t, fixed_pos));
                 }
-                constraints.push(Box::new(PositionConstraint {
+                constraints.push(Constraint::from(PositionConstraint {
                     name: name.clone().unwrap_or_else(|| format!("position at s={s}")),
                     boundary: model.boundary(t),
                     rows,
@@ -781,7 +781,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                         )));
                     }
                 }
-                constraints.push(Box::new(RelativePositionConstraint {
+                constraints.push(Constraint::from(RelativePositionConstraint {
                     name: name
                         .clone()
                         .unwrap_or_else(|| format!("relative position {s_a}→{s_b}")),
@@ -828,7 +828,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 if let Some(Some(local)) = converted.as_ref().map(|c| c[i].clone()) {
                     rows = local;
                 }
-                constraints.push(Box::new(OrientationConstraint::new(
+                constraints.push(Constraint::from(OrientationConstraint::new(
                     &model,
                     name.clone()
                         .unwrap_or_else(|| format!("orientation at s={s}")),
@@ -868,7 +868,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 (r, 0.0)
             })
             .collect();
-        constraints.push(Box::new(crate::constraints::LinearConstraint {
+        constraints.push(Constraint::from(crate::constraints::LinearConstraint {
             name: "continuity at the split".into(),
             rows,
         }));
@@ -893,7 +893,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             rotation,
         ));
         obstacles.push(ob.clone());
-        constraints.push(Box::new(ObstacleConstraint {
+        constraints.push(Constraint::from(ObstacleConstraint {
             obstacle: ob,
             samples: samples.clone(),
             clearance: (radius + margin) / l,
@@ -904,7 +904,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         let ts: Vec<f64> = (0..=d.samples)
             .map(|j| j as f64 / d.samples as f64)
             .collect();
-        constraints.push(Box::new(SelfContactConstraint::new(
+        constraints.push(Constraint::from(SelfContactConstraint::new(
             samples.clone(),
             &ts,
             2.0 * radius / l,

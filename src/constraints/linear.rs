@@ -1,7 +1,7 @@
 //! General linear rows `Σ cⱼ aⱼ = rhs` in coefficient space (e.g. the planner's fixed
 //! conditions on path coefficients).
 
-use super::{Adjoint, Constraint};
+use super::{Adjoint, Rows};
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::Sense;
@@ -15,7 +15,7 @@ pub struct LinearConstraint {
     pub rows: Vec<(Vec<(usize, f64)>, f64)>,
 }
 
-impl Constraint for LinearConstraint {
+impl Rows for LinearConstraint {
     fn label(&self) -> String {
         self.name.clone()
     }
@@ -36,11 +36,5 @@ impl Constraint for LinearConstraint {
                 adj.coef[j] += wi * c;
             }
         }
-    }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

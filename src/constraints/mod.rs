@@ -68,8 +68,9 @@ impl Adjoint {
     }
 }
 
-/// A block of constraint rows.
-pub trait Constraint: Send + Sync + std::fmt::Debug {
+/// The rows of one constraint kind: what every kind implements, and what [`Constraint`]
+/// dispatches to.
+pub(crate) trait Rows {
     /// Human-readable label (used in reports and errors).
     fn label(&self) -> String;
     /// Number of rows.
@@ -80,24 +81,98 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn values(&self, model: &Model, a: &[f64], shape: &Shape, out: &mut [f64]);
     /// Adds `Σᵢ wᵢ ∇cᵢ` to `adj` (rows with `wᵢ = 0` may be skipped).
     fn add_gradient(&self, model: &Model, a: &[f64], shape: &Shape, w: &[f64], adj: &mut Adjoint);
-    /// Adds `Σᵢ wᵢ Jᵀ (∂²gᵢ/∂x²) J` to the row-major `n×n` matrix `h`, where a row is
-    /// `gᵢ(x)` of positions `x` with Jacobian `J`: the part of `∇²cᵢ` that
-    /// [`Adjoint::finish_hessian`] (the positions' own curvature) does not hold. Rows linear in
-    /// the positions have none (the default).
+    /// See [`Constraint::add_curvature`]; rows linear in the positions have none (the default).
     fn add_curvature(&self, model: &Model, a: &[f64], shape: &Shape, w: &[f64], h: &mut [f64]) {
         let _ = (model, a, shape, w, h);
     }
-    /// Clones into a box.
-    fn boxed_clone(&self) -> Box<dyn Constraint>;
-    /// For reports that treat some kinds specially.
-    fn as_any(&self) -> &dyn std::any::Any;
 }
 
-impl Clone for Box<dyn Constraint> {
-    fn clone(&self) -> Self {
-        self.boxed_clone()
+/// A block of constraint rows: one of the kinds of §3.2. The set is closed, so code that treats
+/// some kinds specially (reactions, the planner's linear rows, the grasp's fingers) matches on
+/// it exhaustively.
+#[derive(Clone, Debug)]
+pub enum Constraint {
+    /// Coordinates of `x(s)` fixed or bounded.
+    Position(PositionConstraint),
+    /// Coordinates of `x(s₁) − x(s₀)` fixed.
+    RelativePosition(RelativePositionConstraint),
+    /// Euler angles (or sums of them) fixed at `s`.
+    Orientation(OrientationConstraint),
+    /// Rows linear in the coefficients.
+    Linear(LinearConstraint),
+    /// Clearance from an obstacle at sample points.
+    Obstacle(ObstacleConstraint),
+    /// Clearance between non-adjacent segments of the rod.
+    SelfContact(SelfContactConstraint),
+}
+
+macro_rules! each_kind {
+    ($c:expr, $k:ident => $e:expr) => {
+        match $c {
+            Constraint::Position($k) => $e,
+            Constraint::RelativePosition($k) => $e,
+            Constraint::Orientation($k) => $e,
+            Constraint::Linear($k) => $e,
+            Constraint::Obstacle($k) => $e,
+            Constraint::SelfContact($k) => $e,
+        }
+    };
+}
+
+impl Constraint {
+    /// Human-readable label (used in reports and errors).
+    pub fn label(&self) -> String {
+        each_kind!(self, k => k.label())
+    }
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        each_kind!(self, k => k.rows())
+    }
+    /// Sense of row `i`.
+    pub fn sense(&self, i: usize) -> Sense {
+        each_kind!(self, k => k.sense(i))
+    }
+    /// Writes the row values.
+    pub fn values(&self, model: &Model, a: &[f64], shape: &Shape, out: &mut [f64]) {
+        each_kind!(self, k => k.values(model, a, shape, out))
+    }
+    /// Adds `Σᵢ wᵢ ∇cᵢ` to `adj` (rows with `wᵢ = 0` may be skipped).
+    pub fn add_gradient(
+        &self,
+        model: &Model,
+        a: &[f64],
+        shape: &Shape,
+        w: &[f64],
+        adj: &mut Adjoint,
+    ) {
+        each_kind!(self, k => k.add_gradient(model, a, shape, w, adj))
+    }
+    /// Adds `Σᵢ wᵢ Jᵀ (∂²gᵢ/∂x²) J` to the row-major `n×n` matrix `h`, where a row is
+    /// `gᵢ(x)` of positions `x` with Jacobian `J`: the part of `∇²cᵢ` that
+    /// [`Adjoint::finish_hessian`] (the positions' own curvature) does not hold. Rows linear in
+    /// the positions have none.
+    pub fn add_curvature(&self, model: &Model, a: &[f64], shape: &Shape, w: &[f64], h: &mut [f64]) {
+        each_kind!(self, k => k.add_curvature(model, a, shape, w, h))
     }
 }
+
+macro_rules! from_kind {
+    ($($kind:ident($t:ty)),*) => {$(
+        impl From<$t> for Constraint {
+            fn from(c: $t) -> Constraint {
+                Constraint::$kind(c)
+            }
+        }
+    )*};
+}
+from_kind!(
+    Position(PositionConstraint),
+    RelativePosition(RelativePositionConstraint),
+    Orientation(OrientationConstraint),
+    Linear(LinearConstraint),
+    Obstacle(ObstacleConstraint),
+    SelfContact(SelfContactConstraint)
+);
 
 /// For constraint `blocks` whose rows sit at `offsets` (`offsets[b]..offsets[b + 1]`) in `y`:
 /// collects the position cotangents of `Σ yᵢ∇cᵢ` in `adj` (cleared first) and adds the blocks'
@@ -105,7 +180,7 @@ impl Clone for Box<dyn Constraint> {
 /// [`Adjoint::finish_hessian`], once the caller has added any other position terms.
 #[allow(clippy::too_many_arguments)]
 pub fn add_weighted_curvature(
-    blocks: &[Box<dyn Constraint>],
+    blocks: &[Constraint],
     offsets: &[usize],
     model: &Model,
     a: &[f64],
@@ -128,7 +203,7 @@ pub fn add_weighted_curvature(
 /// row-major `n×n` matrix `h`; rows laid out as in [`add_weighted_curvature`], `adj` is scratch.
 #[allow(clippy::too_many_arguments)]
 pub fn add_penalty_gauss_newton(
-    blocks: &[Box<dyn Constraint>],
+    blocks: &[Constraint],
     offsets: &[usize],
     model: &Model,
     a: &[f64],

@@ -3,7 +3,7 @@
 //! (negative inside). Its gradient is `−n · ∂x/∂a` with `n` the outward normal. The multiplier
 //! `λ ≥ 0` of a row is the contact force magnitude at that sample, pushing along `n`.
 
-use super::{Adjoint, Constraint};
+use super::{Adjoint, Rows};
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::obstacle::Obstacle;
@@ -23,7 +23,7 @@ pub struct ObstacleConstraint {
     pub length: f64,
 }
 
-impl Constraint for ObstacleConstraint {
+impl Rows for ObstacleConstraint {
     fn label(&self) -> String {
         format!("obstacle {}", self.obstacle.name)
     }
@@ -88,12 +88,6 @@ impl Constraint for ObstacleConstraint {
                 }
             }
         }
-    }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 

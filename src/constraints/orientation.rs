@@ -8,7 +8,7 @@
 //! `φ` and `ψ` separately fixes the same rotation while letting twist turn into writhe (a loop
 //! forms by `φ` winding while `ψ` unwinds), which kinking needs.
 
-use super::{Adjoint, Constraint};
+use super::{Adjoint, Rows};
 use crate::kinematics::Shape;
 use crate::layout::Field;
 use crate::model::Model;
@@ -58,7 +58,7 @@ impl OrientationConstraint {
     }
 }
 
-impl Constraint for OrientationConstraint {
+impl Rows for OrientationConstraint {
     fn label(&self) -> String {
         self.name.clone()
     }
@@ -86,11 +86,5 @@ impl Constraint for OrientationConstraint {
                 }
             }
         }
-    }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

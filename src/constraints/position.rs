@@ -1,6 +1,6 @@
 //! Position of a point (fixed supports, fingers) and relative position of two points (eq. 14).
 
-use super::{Adjoint, Constraint};
+use super::{Adjoint, Rows};
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::Sense;
@@ -27,7 +27,7 @@ pub struct PositionConstraint {
     pub rows: Vec<(usize, Bound)>,
 }
 
-impl Constraint for PositionConstraint {
+impl Rows for PositionConstraint {
     fn label(&self) -> String {
         self.name.clone()
     }
@@ -61,12 +61,6 @@ impl Constraint for PositionConstraint {
             adj.add_pos(self.boundary, wi, v);
         }
     }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// `x_k(b) − x_k(a) = l_k` for the listed components (eq. 14).
@@ -82,7 +76,7 @@ pub struct RelativePositionConstraint {
     pub rows: Vec<(usize, f64)>,
 }
 
-impl Constraint for RelativePositionConstraint {
+impl Rows for RelativePositionConstraint {
     fn label(&self) -> String {
         self.name.clone()
     }
@@ -105,11 +99,5 @@ impl Constraint for RelativePositionConstraint {
             adj.add_pos(self.to, wi, v);
             adj.add_pos(self.from, -wi, v);
         }
-    }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

@@ -3,7 +3,7 @@
 //! rod by at least `2r` of arc length (the paper's condition `|sᵢ − sⱼ| ≥ r(sᵢ) + r(sⱼ)`).
 //! Chord–chord distance (not point–point) keeps a strand from slipping between two samples.
 
-use super::{Adjoint, Constraint};
+use super::{Adjoint, Rows};
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::optim::Sense;
@@ -126,7 +126,7 @@ impl SelfContactConstraint {
     }
 }
 
-impl Constraint for SelfContactConstraint {
+impl Rows for SelfContactConstraint {
     fn label(&self) -> String {
         "self contact".into()
     }
@@ -157,11 +157,5 @@ impl Constraint for SelfContactConstraint {
             adj.add_pos(self.samples[j], wi * (1.0 - t), n);
             adj.add_pos(self.samples[j + 1], wi * t, n);
         }
-    }
-    fn boxed_clone(&self) -> Box<dyn Constraint> {
-        Box::new(self.clone())
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

@@ -9,7 +9,7 @@
 //! are `r0 ± P/2`, where `P` is the net normal force the pair exerts, and each carries half the
 //! tangential force.
 
-use crate::constraints::{Bound, PositionConstraint};
+use crate::constraints::{Bound, Constraint};
 use crate::problem::StaticProblem;
 use serde::Serialize;
 
@@ -47,7 +47,7 @@ pub struct ContactForce {
 pub fn fingers(p: &StaticProblem) -> Vec<Finger> {
     let mut out: Vec<Finger> = Vec::new();
     for (block, con) in p.constraints.iter().enumerate() {
-        let Some(pc) = con.as_any().downcast_ref::<PositionConstraint>() else {
+        let Constraint::Position(pc) = con else {
             continue;
         };
         let unilateral: Vec<usize> = (0..pc.rows.len())

@@ -52,10 +52,10 @@ impl EndPose {
     }
 
     /// Constraint blocks prescribing this pose.
-    pub fn constraints(&self, model: &Model) -> Vec<Box<dyn Constraint>> {
-        let mut out: Vec<Box<dyn Constraint>> = Vec::new();
+    pub fn constraints(&self, model: &Model) -> Vec<Constraint> {
+        let mut out: Vec<Constraint> = Vec::new();
         if !self.position.is_empty() {
-            out.push(Box::new(PositionConstraint {
+            out.push(Constraint::from(PositionConstraint {
                 name: "controlled end position".into(),
                 boundary: model.boundary(1.0),
                 rows: self
@@ -66,7 +66,7 @@ impl EndPose {
             }));
         }
         if !self.angles.is_empty() {
-            out.push(Box::new(OrientationConstraint::new(
+            out.push(Constraint::from(OrientationConstraint::new(
                 model,
                 "controlled end orientation".into(),
                 1.0,

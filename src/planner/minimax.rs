@@ -12,9 +12,7 @@
 //! interior sample `k_j`: each block's rows are repeated per sample. Energies are dimensionless
 //! (`Rf/L`), positions in units of `L`.
 
-use crate::constraints::{
-    Adjoint, Constraint, ObstacleConstraint, add_penalty_gauss_newton, add_weighted_curvature,
-};
+use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
 use crate::energy::Objective;
 use crate::hessian::add_rank_one;
 use crate::kinematics::Shape;
@@ -34,7 +32,7 @@ pub struct MinimaxProblem {
     /// Sampled path parameters (including 0 and 1).
     pub ks: Vec<f64>,
     /// Constraint blocks that hold at every interior sample.
-    pub blocks: Vec<Box<dyn Constraint>>,
+    pub blocks: Vec<Constraint>,
     /// Smoothing sharpness `β` (dimensionless energy⁻¹).
     pub beta: f64,
     /// Weight of the mean energy.
@@ -70,7 +68,7 @@ impl MinimaxProblem {
         model: Model,
         path: DeformationPath,
         ks: Vec<f64>,
-        blocks: Vec<Box<dyn Constraint>>,
+        blocks: Vec<Constraint>,
         objective: Objective,
     ) -> Self {
         let interior: Vec<usize> = (0..ks.len())
@@ -153,10 +151,9 @@ impl MinimaxProblem {
             && self.swept.is_none()
             && m.loads.is_empty()
             && !m.energy_roots.is_empty()
-            && self.blocks.iter().all(|b| {
-                b.as_any()
-                    .downcast_ref::<ObstacleConstraint>()
-                    .is_some_and(|o| o.obstacle.distance_is_lipschitz())
+            && self.blocks.iter().all(|b| match b {
+                Constraint::Obstacle(o) => o.obstacle.distance_is_lipschitz(),
+                _ => false,
             });
         self.skip = match (eligible, m.position_bound_weights()) {
             (true, Some(omega)) => {

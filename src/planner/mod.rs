@@ -21,10 +21,7 @@ pub mod trajectory;
 pub mod verify;
 
 use crate::case::Case;
-use crate::constraints::{
-    Angle, Constraint, LinearConstraint, ObstacleConstraint, OrientationConstraint,
-    PositionConstraint,
-};
+use crate::constraints::{Angle, Constraint};
 use crate::error::Error;
 use crate::kinematics::Shape;
 use crate::obstacle::Obstacle;
@@ -69,7 +66,7 @@ pub fn clearance(p: &StaticProblem, positions: &[[f64; 3]]) -> Option<f64> {
     let r = p.model.rod.radius;
     let mut best: Option<f64> = None;
     for con in &p.constraints {
-        if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
+        if let Constraint::Obstacle(ob) = con {
             for x in positions {
                 let (d, _) = ob.obstacle.signed_distance(x.map(|v| v * l));
                 best = Some(best.map_or(d - r, |b: f64| b.min(d - r)));
@@ -81,43 +78,44 @@ pub fn clearance(p: &StaticProblem, positions: &[[f64; 3]]) -> Option<f64> {
 
 /// Splits the case's constraints into linear rows (eliminated from the path), blocks that hold
 /// at every sampled `k`, and nothing (the fixed base's own position, which is constant).
-fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Box<dyn Constraint>>) {
+fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Constraint>) {
     let model = &p.model;
     let n = model.n();
     let mut linear = Vec::new();
-    let mut blocks: Vec<Box<dyn Constraint>> = Vec::new();
+    let mut blocks: Vec<Constraint> = Vec::new();
     for con in &p.constraints {
-        let any = con.as_any();
-        if let Some(oc) = any.downcast_ref::<OrientationConstraint>() {
-            for &(ang, _) in &oc.rows {
-                let mut row = vec![0.0; n];
-                for &(f, w) in ang.terms() {
-                    let off = model.layout.offset(f).expect("validated field");
-                    for (i, e) in oc.e.iter().enumerate() {
-                        row[off + i] += w * e;
+        match con {
+            Constraint::Orientation(oc) => {
+                for &(ang, _) in &oc.rows {
+                    let mut row = vec![0.0; n];
+                    for &(f, w) in ang.terms() {
+                        let off = model.layout.offset(f).expect("validated field");
+                        for (i, e) in oc.e.iter().enumerate() {
+                            row[off + i] += w * e;
+                        }
                     }
+                    linear.push(row);
                 }
-                linear.push(row);
             }
-        } else if let Some(lc) = any.downcast_ref::<LinearConstraint>() {
-            for (r, _) in &lc.rows {
-                let mut row = vec![0.0; n];
-                for &(j, c) in r {
-                    row[j] += c;
+            Constraint::Linear(lc) => {
+                for (r, _) in &lc.rows {
+                    let mut row = vec![0.0; n];
+                    for &(j, c) in r {
+                        row[j] += c;
+                    }
+                    linear.push(row);
                 }
-                linear.push(row);
             }
-        } else if let Some(ob) = any.downcast_ref::<ObstacleConstraint>() {
-            let mut o = ob.clone();
-            o.clearance += safety;
-            blocks.push(Box::new(o));
-        } else if let Some(pc) = any.downcast_ref::<PositionConstraint>()
-            && pc.boundary == 0
-            && !model.layout.free_base
-        {
+            Constraint::Obstacle(ob) => {
+                let mut o = ob.clone();
+                o.clearance += safety;
+                blocks.push(o.into());
+            }
             // x(0) is the fixed base: constant along every path.
-        } else {
-            blocks.push(con.clone());
+            Constraint::Position(pc) if pc.boundary == 0 && !model.layout.free_base => {}
+            Constraint::Position(_)
+            | Constraint::RelativePosition(_)
+            | Constraint::SelfContact(_) => blocks.push(con.clone()),
         }
     }
     (linear, blocks)
@@ -228,9 +226,9 @@ fn end_inside_obstacle(case: &Case, end: &End) -> Option<String> {
         p[k] = x * l;
     }
     case.problem.constraints.iter().find_map(|c| {
-        let oc = c
-            .as_any()
-            .downcast_ref::<crate::constraints::ObstacleConstraint>()?;
+        let Constraint::Obstacle(oc) = c else {
+            return None;
+        };
         let d = oc.obstacle.signed_distance_value(p);
         let need = oc.clearance * l;
         (d < need).then(|| {
@@ -255,13 +253,13 @@ fn end_angles(end: &End) -> Option<[f64; 3]> {
 /// constraints at `s = 0` (a prescribed `φ + ψ` counts as `ψ`), zero where nothing is
 /// prescribed (the natural state's frame); and whether `φ(0)` itself is prescribed.
 fn held_frame(case: &Case) -> ([f64; 3], bool) {
-    use crate::constraints::{Angle, OrientationConstraint};
+    use crate::constraints::Angle;
     use crate::layout::Field;
     let mut angles = [0.0; 3];
     let mut phi_fixed = false;
     // The rows the problem holds (in the rod's angles' frame, which may not be the case's).
     for c in &case.problem.constraints {
-        let Some(oc) = c.as_any().downcast_ref::<OrientationConstraint>() else {
+        let Constraint::Orientation(oc) = c else {
             continue;
         };
         if oc.t != 0.0 {
@@ -334,7 +332,7 @@ impl Planner {
         self.base
             .constraints
             .iter()
-            .any(|c| c.as_any().is::<crate::constraints::SelfContactConstraint>())
+            .any(|c| matches!(c, Constraint::SelfContact(_)))
     }
 
     /// The straight-line path `c = 0` and the path's unknowns' count.

@@ -132,7 +132,7 @@ fn contact_force(base: &StaticProblem, sol: &StaticSolution) -> f64 {
     base.constraints
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.as_any().is::<crate::constraints::ObstacleConstraint>())
+        .filter(|(_, c)| matches!(c, crate::constraints::Constraint::Obstacle(_)))
         .flat_map(|(i, _)| sol.lambda[base.rows_of(i)].iter())
         .map(|&l| l.max(0.0) * fu)
         .sum()

@@ -18,7 +18,7 @@
 //! smoothed as `√(|Δ|² + δ²) − δ` with `δ = 1e-4` (units of `L`), so rows stay differentiable
 //! where a point does not move (the clamped base).
 
-use crate::constraints::{Adjoint, Constraint, ObstacleConstraint};
+use crate::constraints::{Adjoint, Constraint};
 use crate::kinematics::Shape;
 use crate::model::Model;
 use crate::path::DeformationPath;
@@ -42,14 +42,13 @@ pub struct Swept {
 impl Swept {
     /// The swept rows for the obstacle blocks among `blocks`, over `interior` samples; `None`
     /// when there is no obstacle or fewer than two interior samples.
-    pub fn new(blocks: &[Box<dyn Constraint>], interior: usize) -> Option<Swept> {
+    pub fn new(blocks: &[Constraint], interior: usize) -> Option<Swept> {
         let obstacles: Vec<(usize, Vec<usize>)> = blocks
             .iter()
             .enumerate()
-            .filter_map(|(i, b)| {
-                b.as_any()
-                    .downcast_ref::<ObstacleConstraint>()
-                    .map(|o| (i, o.samples.clone()))
+            .filter_map(|(i, b)| match b {
+                Constraint::Obstacle(o) => Some((i, o.samples.clone())),
+                _ => None,
             })
             .collect();
         if obstacles.is_empty() || interior < 2 {
@@ -170,7 +169,7 @@ impl Swept {
         &self,
         model: &Model,
         path: &DeformationPath,
-        blocks: &[Box<dyn Constraint>],
+        blocks: &[Constraint],
         kin: &[f64],
         a: &[&[f64]],
         shapes: &[&Shape],

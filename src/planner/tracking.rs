@@ -5,7 +5,7 @@
 use super::minimax::MinimaxProblem;
 use super::optimise::Tally;
 use super::{Planner, replay};
-use crate::constraints::ObstacleConstraint;
+use crate::constraints::Constraint;
 use crate::optim::{AlOptions, augmented_lagrangian_observed};
 
 /// Equilibrium tracking ends after a round that brings the sampled shapes less than this
@@ -36,10 +36,8 @@ impl Planner {
         // Targets keep the optimiser's safety margin from obstacles.
         let mut inflated = self.base.clone();
         for con in inflated.constraints.iter_mut() {
-            if let Some(ob) = con.as_any().downcast_ref::<ObstacleConstraint>() {
-                let mut o = ob.clone();
-                o.clearance += self.options.safety;
-                *con = Box::new(o);
+            if let Constraint::Obstacle(ob) = con {
+                ob.clearance += self.options.safety;
             }
         }
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of

@@ -83,9 +83,9 @@ fn clamped_load_is_four_times_pinned() {
     let exact = 4.0 * pinned_elastica_load(0.6) / 100.0_f64.powi(2);
     let p0 = pinned_problem(0.6, 4);
     let model = p0.model.clone();
-    let c: Vec<Box<dyn Constraint>> = vec![
+    let c: Vec<Constraint> = vec![
         clamp(&model, 0.0),
-        Box::new(PositionConstraint {
+        Constraint::from(PositionConstraint {
             name: "end".into(),
             boundary: model.boundary(1.0),
             rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(0.6))],

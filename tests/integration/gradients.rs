@@ -298,7 +298,7 @@ fn obstacle(name: &str, shape: ObstacleShape, position: [f64; 3]) -> Arc<Obstacl
     ))
 }
 
-fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
+fn all_constraints(m: &Model) -> Vec<Constraint> {
     let v = |x: f64, y: f64, z: f64| Vector::new(x, y, z);
     let spatial = m.layout.spatial;
     let (verts, faces) = read_obj(include_str!("../../planning_cases/meshes/cube.obj")).unwrap();
@@ -358,8 +358,8 @@ fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
     ];
     let samples: Vec<usize> = (0..=16).map(|j| m.boundary(j as f64 / 16.0)).collect();
     let ts: Vec<f64> = (0..=16).map(|j| j as f64 / 16.0).collect();
-    let mut out: Vec<Box<dyn Constraint>> = vec![
-        Box::new(PositionConstraint {
+    let mut out: Vec<Constraint> = vec![
+        Constraint::from(PositionConstraint {
             name: "pos".into(),
             boundary: m.boundary(1.0),
             rows: vec![
@@ -368,13 +368,13 @@ fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
                 (2, Bound::AtLeast(0.2)),
             ],
         }),
-        Box::new(RelativePositionConstraint {
+        Constraint::from(RelativePositionConstraint {
             name: "rel".into(),
             from: m.boundary(0.25),
             to: m.boundary(0.6),
             rows: vec![(0, 0.1), (2, 0.3)],
         }),
-        Box::new(OrientationConstraint::new(
+        Constraint::from(OrientationConstraint::new(
             m,
             "ori".into(),
             0.6,
@@ -388,14 +388,14 @@ fn all_constraints(m: &Model) -> Vec<Box<dyn Constraint>> {
                 vec![(Angle::Field(Field::Theta), 0.2)]
             },
         )),
-        Box::new(LinearConstraint {
+        Constraint::from(LinearConstraint {
             name: "lin".into(),
             rows: vec![(vec![(0, 1.0), (3, -2.0)], 0.5)],
         }),
-        Box::new(SelfContactConstraint::new(samples.clone(), &ts, 0.9)),
+        Constraint::from(SelfContactConstraint::new(samples.clone(), &ts, 0.9)),
     ];
     for o in shapes {
-        out.push(Box::new(ObstacleConstraint {
+        out.push(Constraint::from(ObstacleConstraint {
             obstacle: o,
             samples: samples.clone(),
             clearance: 0.01,

@@ -79,7 +79,7 @@ pub fn pinned_problem(ratio: f64, pairs: usize) -> StaticProblem {
         &[],
     );
     let end = model.boundary(1.0);
-    let c: Vec<Box<dyn Constraint>> = vec![Box::new(PositionConstraint {
+    let c: Vec<Constraint> = vec![Constraint::from(PositionConstraint {
         name: "right pin".into(),
         boundary: end,
         rows: vec![(0, Bound::Equal(0.0)), (2, Bound::Equal(ratio))],
@@ -88,8 +88,8 @@ pub fn pinned_problem(ratio: f64, pairs: usize) -> StaticProblem {
 }
 
 /// Clamped at `t = 0` (θ = 0) as an orientation constraint, for tests.
-pub fn clamp(model: &Model, t: f64) -> Box<dyn Constraint> {
-    Box::new(OrientationConstraint::new(
+pub fn clamp(model: &Model, t: f64) -> Constraint {
+    Constraint::from(OrientationConstraint::new(
         model,
         "clamp".into(),
         t,
