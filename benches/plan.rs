@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dlo_planner::case;
-use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter};
+use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter};
 use dlo_planner::planner::Planner;
 use dlo_planner::planner::observer::Silent;
 use dlo_planner::planner::replay::{ReplayOptions, replay};

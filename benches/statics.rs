@@ -4,8 +4,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dlo_planner::case;
-use dlo_planner::energy::Objective;
-use dlo_planner::kinematics::Shape;
+use dlo_planner::rod::energy::Objective;
+use dlo_planner::rod::kinematics::Shape;
 use dlo_planner::statics::{StaticOptions, solve_static};
 use std::hint::black_box;
 use std::path::Path;

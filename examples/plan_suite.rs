@@ -23,9 +23,9 @@
 //! "worst false collision-free" of the table: it must be ≥ −1e-6 L).
 
 use dlo_planner::case;
-use dlo_planner::kinematics::Shape;
 use dlo_planner::planner::observer::Silent;
 use dlo_planner::planner::{PlanResult, PlanStatus, Planner};
+use dlo_planner::rod::kinematics::Shape;
 use std::path::Path;
 use std::time::Instant;
 

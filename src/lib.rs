@@ -16,33 +16,16 @@
 //! `mcap` ([`mcap_log`]: MCAP logs for Foxglove) and `plot` ([`plot`]: SVG pictures of logs); a
 //! library user who needs neither depends on it with `default-features = false`.
 
-pub mod balance;
-pub mod basis;
 pub mod case;
 pub mod constraints;
-pub mod energy;
 pub mod error;
 pub mod grasp;
-pub mod hessian;
-pub mod kinematics;
-pub mod layout;
-#[cfg(feature = "mcap")]
-pub mod mcap_log;
-pub mod mesh;
-pub mod model;
-pub mod obstacle;
+mod kernels;
 pub mod optim;
-pub mod path;
+pub mod output;
 pub mod planner;
-#[cfg(feature = "plot")]
-pub mod plot;
-pub mod problem;
-pub mod quadrature;
-pub mod report;
 pub mod rod;
-pub mod stability;
+pub mod scene;
 pub mod statics;
-pub mod trig;
-pub mod wide;
 
 pub use error::Error;

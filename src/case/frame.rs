@@ -27,11 +27,10 @@
 
 use super::{CaseFile, ConstraintSpec};
 use crate::constraints::Angle;
-use crate::kinematics::{angles_of, cross, is_rotation, rotation};
-use crate::layout::Field;
-use crate::model::Model;
 use crate::planner::orientation::{Matrix, nearest};
 use crate::planner::spec::{EndSpec, EulerBranch};
+use crate::rod::kinematics::{angles_of, cross, in_frame, is_rotation, rotation};
+use crate::rod::layout::Field;
 use std::f64::consts::PI;
 
 /// How a case's 3D angles are measured (the case file's `angle_frame`).
@@ -433,7 +432,9 @@ fn farthest_on_sphere(lines: &[([f64; 3], f64)]) -> [f64; 3] {
 /// The case's orientation constraints as rows on the angles of `r` (see the module
 /// documentation), in the order of `file.constraints`; `None` for one that is not an
 /// orientation.
-pub(crate) fn convert(file: &CaseFile, model: &Model) -> Vec<Option<Vec<(Angle, f64)>>> {
+pub(crate) fn convert(file: &CaseFile, r: [[f64; 3]; 3]) -> Vec<Option<Vec<(Angle, f64)>>> {
+    let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
+    let frame = (!identity).then_some(r);
     let mut order: Vec<(usize, f64, Written)> = file
         .constraints
         .iter()
@@ -443,7 +444,7 @@ pub(crate) fn convert(file: &CaseFile, model: &Model) -> Vec<Option<Vec<(Angle, 
         .collect();
     order.sort_by(|a, b| a.1.total_cmp(&b.1));
     let mut out = vec![None; file.constraints.len()];
-    let local = |a: [f64; 3]| model.rotation_to_angles(rotation(a[0], a[1], a[2]));
+    let local = |a: [f64; 3]| in_frame(frame.as_ref(), rotation(a[0], a[1], a[2]));
     // The written angles (ψ filled in from the previous where a tangent leaves it) and their
     // angles in `r`, of the previous constraint.
     let mut prev: Option<([f64; 3], [f64; 3])> = None;

@@ -9,19 +9,16 @@ mod strict_json;
 
 pub use limits::*;
 
-use crate::basis::Basis;
-use crate::constraints::{
-    Angle, Bound, Constraint, ObstacleConstraint, OrientationConstraint, PositionConstraint,
-    RelativePositionConstraint, SelfContactConstraint,
-};
+use crate::constraints::{Angle, Bound};
 use crate::error::Error;
-use crate::layout::{Field, Layout};
-use crate::model::{Discretisation, Model, PointLoad};
-use crate::obstacle::{Obstacle, ObstacleShape};
 use crate::optim::AlOptions;
-use crate::problem::StaticProblem;
+use crate::rod::basis::Basis;
+use crate::rod::layout::{Field, Layout};
+use crate::rod::model::Discretisation;
 use crate::rod::{Profile, Rod};
+use crate::scene::obstacle::{Obstacle, ObstacleShape};
 use crate::statics::StaticOptions;
+use crate::statics::problem::StaticProblem;
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{
     Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags,
@@ -111,7 +108,7 @@ pub struct DiscretisationSpec {
     /// Sine/cosine pairs per field (paper: 4, i.e. 10 functions).
     pub basis_pairs: usize,
     /// The functions: `"paper"` (default) or `"legendre"`.
-    pub basis: crate::basis::BasisKind,
+    pub basis: crate::rod::basis::BasisKind,
     /// Uniform quadrature panels.
     pub panels: usize,
     /// Gauss points per panel.
@@ -124,7 +121,7 @@ impl Default for DiscretisationSpec {
     fn default() -> Self {
         DiscretisationSpec {
             basis_pairs: 4,
-            basis: crate::basis::BasisKind::Paper,
+            basis: crate::rod::basis::BasisKind::Paper,
             panels: 16,
             gauss_points: 4,
             samples: 32,
@@ -601,34 +598,31 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         ));
     }
 
-    // Points where positions are needed.
-    // Sample points become panel boundaries only where obstacles or self-contact need them.
-    let needs_samples = !file.obstacles.is_empty() || file.self_contact;
-    let mut points: Vec<f64> = if needs_samples {
-        (0..=d.samples)
-            .map(|j| j as f64 / d.samples as f64)
-            .collect()
-    } else {
-        vec![0.0, 1.0]
-    };
-    if let Some(sa) = s_split {
-        points.push(sa / l);
-    }
+    // Arc lengths first, then loads, then each constraint's content.
     for (i, c) in file.constraints.iter().enumerate() {
         match c {
             ConstraintSpec::Position { s, .. } | ConstraintSpec::Orientation { s, .. } => {
-                points.push(v.arc(&format!("constraints[{i}].s"), *s, l)?)
+                v.arc(&format!("constraints[{i}].s"), *s, l)?;
             }
             ConstraintSpec::RelativePosition { s_a, s_b, .. } => {
-                points.push(v.arc(&format!("constraints[{i}].s_a"), *s_a, l)?);
-                points.push(v.arc(&format!("constraints[{i}].s_b"), *s_b, l)?);
+                v.arc(&format!("constraints[{i}].s_a"), *s_a, l)?;
+                v.arc(&format!("constraints[{i}].s_b"), *s_b, l)?;
             }
         }
     }
-    let fu = rod.force_unit();
-    let mut loads = Vec::new();
+    let mut builder = StaticProblem::builder(rod.clone(), layout)
+        .discretisation(Discretisation {
+            panels: d.panels,
+            gauss_points: d.gauss_points,
+        })
+        .samples(d.samples)
+        .base(base)
+        .self_contact(file.self_contact);
+    if let Some(sa) = s_split {
+        builder = builder.register_point(sa);
+    }
     for (i, f) in file.forces.iter().enumerate() {
-        let t = v.arc(&format!("forces[{i}].s"), f.s, l)?;
+        v.arc(&format!("forces[{i}].s"), f.s, l)?;
         let force = v.vec3(&format!("forces[{i}].force"), f.force)?;
         let reference = v.vec3(&format!("forces[{i}].reference"), f.reference)?;
         if file.planar && force[1] != 0.0 {
@@ -637,35 +631,16 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 "a planar rod cannot take a y force",
             ));
         }
-        loads.push(PointLoad {
-            t,
-            force: force.map(|c| c / fu),
-            reference: reference.map(|c| c / l),
-        });
+        builder = builder.load(f.s, force, reference);
     }
-    let disc = Discretisation {
-        panels: d.panels,
-        gauss_points: d.gauss_points,
-    };
-    let model = Model::new(
-        rod.clone(),
-        layout,
-        disc,
-        base.map(|c| c / l),
-        loads,
-        &points,
-    );
-    // The angles' reference frame, away from the pole where the case allows it.
+    // The angles' reference frame, away from the pole where the case allows it, and the
+    // orientation constraints written in it.
     let angle_frame = frame::choose(&file).map_err(|m| v.err("angle_frame", m))?;
-    let (model, converted) = match angle_frame.and_then(|r| model.clone().with_frame(r)) {
-        Some(m) => {
-            let rows = frame::convert(&file, &m);
-            (m, Some(rows))
-        }
-        None => (model, None),
-    };
+    let converted = angle_frame.map(|r| {
+        builder = builder.clone().angle_frame(r);
+        frame::convert(&file, r)
+    });
 
-    let mut constraints: Vec<Constraint> = Vec::new();
     // Fixed points for the reachability check: (t, position, all components fixed).
     let mut fixed: Vec<(f64, [f64; 3])> = Vec::new();
     if !file.base.free {
@@ -700,7 +675,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                     match *cs {
                         CoordSpec::Equal(val) => {
                             v.finite(&field(nm), val)?;
-                            rows.push((k, Bound::Equal(val / l)));
+                            rows.push((k, Bound::Equal(val)));
                             fixed_pos[k] = val;
                         }
                         CoordSpec::Range(RangeSpec { min, max }) => {
@@ -712,11 +687,11 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                             }
                             if let Some(mn) = min {
                                 v.finite(&format!("{}.min", field(nm)), mn)?;
-                                rows.push((k, Bound::AtLeast(mn / l)));
+                                rows.push((k, Bound::AtLeast(mn)));
                             }
                             if let Some(mx) = max {
                                 v.finite(&format!("{}.max", field(nm)), mx)?;
-                                rows.push((k, Bound::AtMost(mx / l)));
+                                rows.push((k, Bound::AtMost(mx)));
                             }
                             if let (Some(mn), Some(mx)) = (min, max)
                                 && mn > mx
@@ -735,11 +710,8 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 if all_fixed {
                     fixed.push((t, fixed_pos));
                 }
-                constraints.push(Constraint::from(PositionConstraint {
-                    name: name.clone().unwrap_or_else(|| format!("position at s={s}")),
-                    boundary: model.boundary(t),
-                    rows,
-                }));
+                let name = name.clone().unwrap_or_else(|| format!("position at s={s}"));
+                builder = builder.position(name, *s, &rows);
             }
             ConstraintSpec::RelativePosition {
                 s_a,
@@ -763,7 +735,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                         ));
                     }
                     v.finite(&field(nm), *val)?;
-                    rows.push((k, val / l));
+                    rows.push((k, *val));
                     vec[k] = *val;
                 }
                 if rows.is_empty() {
@@ -781,14 +753,10 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                         )));
                     }
                 }
-                constraints.push(Constraint::from(RelativePositionConstraint {
-                    name: name
-                        .clone()
-                        .unwrap_or_else(|| format!("relative position {s_a}→{s_b}")),
-                    from: model.boundary(s_a / l),
-                    to: model.boundary(s_b / l),
-                    rows,
-                }));
+                let name = name
+                    .clone()
+                    .unwrap_or_else(|| format!("relative position {s_a}→{s_b}"));
+                builder = builder.relative_position(name, *s_a, *s_b, &rows);
             }
             ConstraintSpec::Orientation {
                 s,
@@ -828,13 +796,10 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
                 if let Some(Some(local)) = converted.as_ref().map(|c| c[i].clone()) {
                     rows = local;
                 }
-                constraints.push(Constraint::from(OrientationConstraint::new(
-                    &model,
-                    name.clone()
-                        .unwrap_or_else(|| format!("orientation at s={s}")),
-                    s / l,
-                    rows,
-                )));
+                let name = name
+                    .clone()
+                    .unwrap_or_else(|| format!("orientation at s={s}"));
+                builder = builder.orientation(name, *s, &rows);
             }
         }
     }
@@ -853,29 +818,6 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         }
     }
 
-    if let Some(row) = layout.basis.continuity_row() {
-        let fields = [Field::Theta, Field::Phi, Field::Psi, Field::Eps];
-        let rows = fields
-            .iter()
-            .filter_map(|&f| layout.offset(f))
-            .map(|off| {
-                let r: Vec<(usize, f64)> = row
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, c)| **c != 0.0)
-                    .map(|(i, c)| (off + i, *c))
-                    .collect();
-                (r, 0.0)
-            })
-            .collect();
-        constraints.push(Constraint::from(crate::constraints::LinearConstraint {
-            name: "continuity at the split".into(),
-            rows,
-        }));
-    }
-    let samples: Vec<usize> = (0..=d.samples)
-        .map(|j| model.boundary(j as f64 / d.samples as f64))
-        .collect();
     let mut obstacles = Vec::new();
     for (i, o) in file.obstacles.iter().enumerate() {
         let f = |x: &str| format!("obstacles[{i}].{x}");
@@ -893,24 +835,11 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
             rotation,
         ));
         obstacles.push(ob.clone());
-        constraints.push(Constraint::from(ObstacleConstraint {
-            obstacle: ob,
-            samples: samples.clone(),
-            clearance: (radius + margin) / l,
-            length: l,
-        }));
+        builder = builder.obstacle(ob, margin);
     }
-    if file.self_contact {
-        let ts: Vec<f64> = (0..=d.samples)
-            .map(|j| j as f64 / d.samples as f64)
-            .collect();
-        constraints.push(Constraint::from(SelfContactConstraint::new(
-            samples.clone(),
-            &ts,
-            2.0 * radius / l,
-        )));
-    }
-
+    let problem = builder
+        .build()
+        .map_err(|e| v.err("constraints", e.to_string()))?;
     let (initial, explicit_shape) = match &file.shape {
         Some(sh) => (
             coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?,
@@ -983,7 +912,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         name,
         description: file.description.clone(),
         path: path.to_path_buf(),
-        problem: StaticProblem::new(model, constraints),
+        problem,
         obstacles,
         initial,
         explicit_shape,
@@ -1061,14 +990,14 @@ fn build_shape(
                     format!("cannot read {}: {e}", full.display()),
                 )
             })?;
-            let obj = crate::mesh::parse_obj(&text)
+            let obj = crate::scene::mesh::parse_obj(&text)
                 .map_err(|e| v.err(format!("{field}.obj"), format!("{}: {e}", full.display())))?;
             let verts: Vec<[f64; 3]> = obj.vertices.iter().map(|p| p.map(|c| c * sc)).collect();
-            crate::mesh::check_solid(&verts, &obj.triangles).map_err(|d| {
+            crate::scene::mesh::check_solid(&verts, &obj.triangles).map_err(|d| {
                 let what = d.describe(|t| format!("line {}", obj.lines[t]));
                 match d {
-                    crate::mesh::MeshDefect::NotFinite { .. }
-                    | crate::mesh::MeshDefect::TooLarge => v.err(
+                    crate::scene::mesh::MeshDefect::NotFinite { .. }
+                    | crate::scene::mesh::MeshDefect::TooLarge => v.err(
                         format!("{field}.scale"),
                         format!("{}: {what}", full.display()),
                     ),
@@ -1172,30 +1101,4 @@ pub(crate) fn coefficients(
     Ok(a)
 }
 
-/// The natural state plus a deterministic perturbation of size `delta` radians: a bulge
-/// `θ = δ(1 − 2t)` plus small multiples of the other modes, so that no symmetry of the problem
-/// survives (a symmetric start converges to a symmetric, possibly unstable, equilibrium).
-pub fn default_start(layout: &Layout, delta: f64, base: [f64; 3]) -> Vec<f64> {
-    let mut a = vec![0.0; layout.len()];
-    let nb = layout.nb();
-    a[0] = delta;
-    a[1] = -2.0 * delta;
-    for (i, ai) in a.iter_mut().enumerate().take(nb).skip(2) {
-        *ai = delta * 0.05 * (1.0 + (i as f64 * 0.7).sin());
-    }
-    if let Some(o) = layout.offset(Field::Phi) {
-        a[o] = 0.3;
-        for i in 2..nb {
-            a[o + i] = delta * 0.05 * (i as f64 * 1.3).cos();
-        }
-    }
-    if let Some(o) = layout.offset(Field::Psi) {
-        a[o] = -0.3;
-    }
-    if let Some(o) = layout.base_offset() {
-        for (k, &c) in layout.components().iter().enumerate() {
-            a[o + k] = base[c];
-        }
-    }
-    a
-}
+pub use crate::statics::problem::default_start;

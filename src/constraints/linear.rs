@@ -2,9 +2,9 @@
 //! conditions on path coefficients).
 
 use super::{Adjoint, Rows};
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// Linear equality rows on the unknowns.
 #[derive(Clone, Debug)]

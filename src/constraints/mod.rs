@@ -2,7 +2,7 @@
 //! dimensionless units, with analytic gradients.
 //!
 //! Gradients are accumulated into an [`Adjoint`]: a vector per mesh boundary (contracted with
-//! `∂x(b)/∂a` in one backward pass, see [`crate::model::Model::add_positions_vjp`]) plus a direct
+//! `∂x(b)/∂a` in one backward pass, see [`crate::rod::model::Model::add_positions_vjp`]) plus a direct
 //! coefficient-space part. Every constraint kind passes the same finite-difference contract test.
 
 mod linear;
@@ -17,9 +17,9 @@ pub use orientation::{Angle, OrientationConstraint};
 pub use position::{Bound, PositionConstraint, RelativePositionConstraint};
 pub use self_contact::{SelfContactConstraint, segment_distance};
 
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// Gradient accumulator: `pos[b]` multiplies `∂x(b)/∂a`; `coef` is added as is.
 #[derive(Clone, Debug, Default)]
@@ -227,7 +227,7 @@ pub fn add_penalty_gauss_newton(
             blk.add_gradient(model, a, shape, &unit, adj);
             gi.iter_mut().for_each(|v| *v = 0.0);
             adj.finish(model, shape, &mut gi);
-            crate::hessian::add_rank_one(h, s[i], &gi);
+            crate::rod::hessian::add_rank_one(h, s[i], &gi);
         }
     }
 }

@@ -4,10 +4,10 @@
 //! `λ ≥ 0` of a row is the contact force magnitude at that sample, pushing along `n`.
 
 use super::{Adjoint, Rows};
-use crate::kinematics::Shape;
-use crate::model::Model;
-use crate::obstacle::Obstacle;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
+use crate::scene::obstacle::Obstacle;
 use std::sync::Arc;
 
 /// One obstacle, checked at a set of mesh boundaries.
@@ -91,11 +91,11 @@ impl Rows for ObstacleConstraint {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn clearances(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f64]) => clearances_body
 }
 
-/// The rows' values from the positions (compiled twice, see [`crate::wide`]).
+/// The rows' values from the positions (compiled twice, see [`crate::kernels::wide`]).
 #[inline(always)]
 fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f64]) {
     for (o, &b) in out.iter_mut().zip(&c.samples) {

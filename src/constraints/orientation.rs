@@ -9,10 +9,10 @@
 //! forms by `φ` winding while `ψ` unwinds), which kinking needs.
 
 use super::{Adjoint, Rows};
-use crate::kinematics::Shape;
-use crate::layout::Field;
-use crate::model::Model;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::layout::Field;
+use crate::rod::model::Model;
 
 /// One prescribed angle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,7 +73,7 @@ impl Rows for OrientationConstraint {
             *o = -v;
             for &(f, w) in ang.terms() {
                 let off = m.layout.offset(f).expect("validated field");
-                *o += w * crate::basis::dot(&a[off..off + self.e.len()], &self.e);
+                *o += w * crate::rod::basis::dot(&a[off..off + self.e.len()], &self.e);
             }
         }
     }

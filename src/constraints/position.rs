@@ -1,9 +1,9 @@
 //! Position of a point (fixed supports, fingers) and relative position of two points (eq. 14).
 
 use super::{Adjoint, Rows};
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// One row of a point constraint on a coordinate (dimensionless, `x/L`).
 #[derive(Clone, Copy, Debug, PartialEq)]

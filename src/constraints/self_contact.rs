@@ -4,9 +4,9 @@
 //! Chord–chord distance (not point–point) keeps a strand from slipping between two samples.
 
 use super::{Adjoint, Rows};
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::Sense;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// Self-contact among chords through sample boundaries.
 #[derive(Clone, Debug)]

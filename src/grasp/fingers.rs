@@ -10,7 +10,7 @@
 //! tangential force.
 
 use crate::constraints::{Bound, Constraint};
-use crate::problem::StaticProblem;
+use crate::statics::problem::StaticProblem;
 use serde::Serialize;
 
 /// One finger of a grasp.

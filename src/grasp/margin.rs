@@ -12,7 +12,7 @@
 use super::fingers::{ContactForce, Finger, contact_forces, fingers, friction_ratio};
 use crate::case::{Case, ForceSpec, variant};
 use crate::error::Error;
-use crate::problem::StaticProblem;
+use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static, solve_static_warm};
 use serde::Serialize;
 
@@ -387,10 +387,10 @@ impl Grasp {
         let old = m.layout;
         let mut a = vec![0.0; lay.len()];
         for f in [
-            crate::layout::Field::Theta,
-            crate::layout::Field::Phi,
-            crate::layout::Field::Psi,
-            crate::layout::Field::Eps,
+            crate::rod::layout::Field::Theta,
+            crate::rod::layout::Field::Phi,
+            crate::rod::layout::Field::Psi,
+            crate::rod::layout::Field::Eps,
         ] {
             if let (Some(o_new), Some(o_old)) = (lay.offset(f), old.offset(f)) {
                 a[o_new..o_new + old.nb()]

@@ -46,7 +46,7 @@ macro_rules! dispatch {
                 fn wide $(<$lt>)? ($($arg: $ty),*) $(-> $ret)? {
                     $body($($arg),*)
                 }
-                if $crate::wide::avx2() {
+                if $crate::kernels::wide::avx2() {
                     // SAFETY: the processor has AVX2 (checked at run time).
                     return unsafe { wide($($arg),*) };
                 }

@@ -132,7 +132,7 @@ pub struct OuterIterate<'a> {
 /// boundary where its penalty curvature enters `∇²Φ`.
 const BOUNDARY_BAND: f64 = 1e-9;
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     /// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier
     /// estimates `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows
     /// whose penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton
@@ -148,7 +148,7 @@ crate::wide::dispatch! {
     ) -> f64 => augment_body
 }
 
-/// [`augment`]'s loop (compiled twice, see [`crate::wide`]).
+/// [`augment`]'s loop (compiled twice, see [`crate::kernels::wide`]).
 #[inline(always)]
 fn augment_body(
     f: f64,

@@ -198,7 +198,7 @@ pub fn bfgs(
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn neg_matvec(h: &[f64], g: &[f64], d: &mut [f64]) => neg_matvec_body
 }
 
@@ -211,7 +211,7 @@ fn neg_matvec_body(h: &[f64], g: &[f64], d: &mut [f64]) {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn inverse_update(h: &mut [f64], s: &[f64], y: &[f64], sy: f64, hy: &mut [f64]) => inverse_update_body
 }
 

@@ -5,6 +5,7 @@
 //! view; a 3D case adds a top view, z–y). Shapes are in the paper's axes: horizontal `z`,
 //! vertical `x` (up).
 
+use crate::output::topics;
 use foxglove::Decode;
 use foxglove::schemas::{Pose, SceneUpdate};
 use plotters::coord::Shift;
@@ -182,24 +183,24 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
         SceneUpdate::decode(&m.data[..]).map_err(|_| PlotError::Decode(m.channel.topic.clone()))
     };
     // A broken file is drawn as far as it can be read.
-    crate::mcap_log::reader::for_each_readable(bytes, |m| -> Result<(), PlotError> {
+    crate::output::mcap_log::reader::for_each_readable(bytes, |m| -> Result<(), PlotError> {
         let topic = m.channel.topic.as_str();
         match topic {
-            "/rod/optimal" | "/rod/feasible" | "/grasp/held_shape" => {
+            topics::ROD_OPTIMAL | topics::ROD_FEASIBLE | topics::GRASP_HELD_SHAPE => {
                 let which = match topic {
-                    "/rod/optimal" => "optimal",
-                    "/rod/feasible" => "feasible",
+                    topics::ROD_OPTIMAL => "optimal",
+                    topics::ROD_FEASIBLE => "feasible",
                     _ => "held",
                 };
                 shapes.insert((which, m.log_time), line_points(&decode(m)?));
             }
-            "/metrics/optimal" | "/metrics/feasible" | "/metrics/straight" => {
+            topics::METRICS_OPTIMAL | topics::METRICS_FEASIBLE | topics::METRICS_STRAIGHT => {
                 let v: serde_json::Value = serde_json::from_slice(&m.data)
                     .map_err(|_| PlotError::Decode(m.channel.topic.clone()))?;
                 if let (Some(k), Some(u)) = (v["k"].as_f64(), v["energy"]["total"].as_f64()) {
                     match topic {
-                        "/metrics/optimal" => energy.insert(("optimal", m.log_time), (k, u)),
-                        "/metrics/feasible" => energy.insert(("feasible", m.log_time), (k, u)),
+                        topics::METRICS_OPTIMAL => energy.insert(("optimal", m.log_time), (k, u)),
+                        topics::METRICS_FEASIBLE => energy.insert(("feasible", m.log_time), (k, u)),
                         _ => {
                             out.straight_energy.push((k, u));
                             None
@@ -207,7 +208,7 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
                     };
                 }
             }
-            "/rod/endpoints" => {
+            topics::ROD_ENDPOINTS => {
                 let up = decode(m)?;
                 let pts = line_points(&up);
                 match up.entities.first().map(|e| e.id.as_str()) {
@@ -216,9 +217,9 @@ pub fn read_frames(bytes: &[u8]) -> Result<PlanFrames, PlotError> {
                     _ => out.goal = Some(pts),
                 }
             }
-            "/rod/shape" => out.shape = Some(line_points(&decode(m)?)),
-            "/scene/obstacles" => out.obstacles = obstacle_triangles(&decode(m)?),
-            "/grasp/fingers" => {
+            topics::SHAPE => out.shape = Some(line_points(&decode(m)?)),
+            topics::OBSTACLES => out.obstacles = obstacle_triangles(&decode(m)?),
+            topics::GRASP_FINGERS => {
                 for e in decode(m)?.entities {
                     for a in &e.arrows {
                         // The arrow ends at the contact, pointing the way the finger pushes.

@@ -13,7 +13,7 @@ const CLEAR_MARGIN: f64 = 1e-6;
 /// inextensible, weightless, fixed base, no loads), with obstacle rows only, a sample needs its
 /// shape only for its rows; and a row value `c = clearance − d(x)/L` changes by at most the
 /// boundary's displacement, which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|`
-/// ([`crate::model::Model::position_bound_weights`]). A sample whose rows all have zero
+/// ([`crate::rod::model::Model::position_bound_weights`]). A sample whose rows all have zero
 /// multipliers and whose largest row, at the coefficients of its last evaluated shape, plus
 /// that bound is below `−CLEAR_MARGIN` keeps its last rows and skips its shape.
 #[derive(Debug)]

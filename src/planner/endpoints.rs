@@ -2,9 +2,9 @@
 //! start and goal static solves (so that both ends of a path are equilibria).
 
 use crate::constraints::{Angle, Bound, Constraint, OrientationConstraint, PositionConstraint};
-use crate::layout::Field;
-use crate::model::Model;
-use crate::problem::StaticProblem;
+use crate::rod::layout::Field;
+use crate::rod::model::Model;
+use crate::statics::problem::StaticProblem;
 use crate::statics::{StaticOptions, StaticSolution, solve_static};
 
 /// Pose of `P(L)`: position rows `(component, x/L)` and Euler-angle rows.

@@ -13,14 +13,14 @@
 //! (`Rf/L`), positions in units of `L`.
 
 use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
-use crate::energy::Objective;
-use crate::hessian::add_rank_one;
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::{Nlp, Sense};
-use crate::path::DeformationPath;
 use crate::planner::clear_samples::ClearSamples;
+use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
+use crate::rod::energy::Objective;
+use crate::rod::hessian::add_rank_one;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// The minimax path problem.
 #[derive(Debug)]

@@ -10,6 +10,7 @@ pub mod minimax;
 pub mod observer;
 mod optimise;
 pub mod orientation;
+pub mod path;
 mod refine;
 pub mod replay;
 pub mod result;
@@ -23,11 +24,11 @@ pub mod verify;
 use crate::case::Case;
 use crate::constraints::{Angle, Constraint};
 use crate::error::Error;
-use crate::kinematics::Shape;
-use crate::obstacle::Obstacle;
 use crate::optim::AlStatus;
-use crate::path::DeformationPath;
-use crate::problem::StaticProblem;
+use crate::planner::path::DeformationPath;
+use crate::rod::kinematics::Shape;
+use crate::scene::obstacle::Obstacle;
+use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
@@ -244,7 +245,7 @@ fn end_inside_obstacle(case: &Case, end: &End) -> Option<String> {
 
 /// All three Euler angles of an end, when its pose gives them.
 fn end_angles(end: &End) -> Option<[f64; 3]> {
-    use crate::layout::Field;
+    use crate::rod::layout::Field;
     let get = |f| end.angles.iter().find(|(g, _)| *g == f).map(|x| x.1);
     Some([get(Field::Phi)?, get(Field::Theta)?, get(Field::Psi)?])
 }
@@ -254,7 +255,7 @@ fn end_angles(end: &End) -> Option<[f64; 3]> {
 /// prescribed (the natural state's frame); and whether `φ(0)` itself is prescribed.
 fn held_frame(case: &Case) -> ([f64; 3], bool) {
     use crate::constraints::Angle;
-    use crate::layout::Field;
+    use crate::rod::layout::Field;
     let mut angles = [0.0; 3];
     let mut phi_fixed = false;
     // The rows the problem holds (in the rod's angles' frame, which may not be the case's).

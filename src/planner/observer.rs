@@ -2,8 +2,8 @@
 //! optimiser's progress. The library prints nothing; the CLI's progress line and the MCAP log
 //! are observers.
 
-use crate::energy::EnergyTerms;
-use crate::model::Model;
+use crate::rod::energy::EnergyTerms;
+use crate::rod::model::Model;
 use crate::statics::Reaction;
 
 /// Which computation a shape belongs to.

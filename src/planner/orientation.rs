@@ -14,7 +14,7 @@
 //! The reference is the held end's frame for the start and the start shape's end for the goal,
 //! so equivalent spellings of a pose give the same angles and the same plan.
 
-use crate::kinematics::{angles_of, rotation};
+use crate::rod::kinematics::{angles_of, rotation};
 use std::f64::consts::{PI, TAU};
 
 /// A rotation matrix (row-major).

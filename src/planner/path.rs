@@ -6,7 +6,7 @@
 //! of that null space and takes `cᵢ = N zᵢ`: the unknowns `z` satisfy the conditions exactly,
 //! with no multipliers and no drift.
 
-use crate::model::LANES;
+use crate::rod::model::LANES;
 
 /// A deformation path between two shapes, parameterised by `z` (`m` blocks of `r` numbers).
 #[derive(Clone, Debug)]
@@ -40,7 +40,7 @@ impl DeformationPath {
                 .map(|q| ns.column(q).iter().copied().collect())
                 .collect()
         };
-        let lanes = crate::model::padded(basis.iter().map(Vec::as_slice), n);
+        let lanes = crate::rod::model::padded(basis.iter().map(Vec::as_slice), n);
         DeformationPath {
             a0,
             a1,
@@ -89,7 +89,7 @@ impl DeformationPath {
         shape_at(self, z, k, out);
     }
 
-    /// [`DeformationPath::shape_at`]'s loops (compiled twice, see [`crate::wide`]).
+    /// [`DeformationPath::shape_at`]'s loops (compiled twice, see [`crate::kernels::wide`]).
     #[inline(always)]
     fn shape_at_body(&self, z: &[f64], k: f64, out: &mut [f64]) {
         if self.lanes.is_empty() {
@@ -134,7 +134,7 @@ impl DeformationPath {
             &mut heap
         };
         for (p, col) in proj.iter_mut().zip(&self.basis) {
-            *p = crate::basis::dot(col, grad_a);
+            *p = crate::rod::basis::dot(col, grad_a);
         }
         for i in 0..self.terms {
             let w = Self::weight(i + 1, k);
@@ -154,7 +154,7 @@ impl DeformationPath {
         let mut hn = vec![0.0; n * r];
         for (q, col) in self.basis.iter().enumerate() {
             for a in 0..n {
-                hn[a * r + q] = crate::basis::dot(&h_a[a * n..(a + 1) * n], col);
+                hn[a * r + q] = crate::rod::basis::dot(&h_a[a * n..(a + 1) * n], col);
             }
         }
         let mut m = vec![0.0; r * r];
@@ -178,6 +178,6 @@ impl DeformationPath {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn shape_at(p: &DeformationPath, z: &[f64], k: f64, out: &mut [f64]) => DeformationPath::shape_at_body
 }

@@ -8,9 +8,9 @@
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
-use crate::kinematics::Shape;
-use crate::path::DeformationPath;
-use crate::problem::StaticProblem;
+use crate::planner::path::DeformationPath;
+use crate::rod::kinematics::Shape;
+use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static_warm};
 use serde::Serialize;
 

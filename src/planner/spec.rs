@@ -244,7 +244,7 @@ pub struct End {
     /// `(component, x/L)` rows.
     pub position: Vec<(usize, f64)>,
     /// `(field, angle)` rows (filled from `rotation` when that is given).
-    pub angles: Vec<(crate::layout::Field, f64)>,
+    pub angles: Vec<(crate::rod::layout::Field, f64)>,
     /// A full orientation whose Euler branch is still to be chosen.
     pub rotation: Option<EndRotation>,
     /// Coefficients (the shape, or the solve's start).
@@ -263,11 +263,11 @@ impl End {
     /// another axis than y).
     pub fn resolve(
         &mut self,
-        model: &crate::model::Model,
+        model: &crate::rod::model::Model,
         reference: [f64; 3],
     ) -> Result<(), String> {
         let planar = !model.layout.spatial;
-        use crate::layout::Field;
+        use crate::rod::layout::Field;
         let Some(r) = self.rotation.take() else {
             return Ok(());
         };
@@ -349,7 +349,7 @@ fn end_rotation(
     v: &V,
     name: &str,
     e: &EndSpec,
-    angles: &mut Vec<(crate::layout::Field, f64)>,
+    angles: &mut Vec<(crate::rod::layout::Field, f64)>,
     spatial: bool,
 ) -> Result<Option<EndRotation>, Error> {
     let f = |x: &str| format!("plan.{name}.{x}");
@@ -413,12 +413,12 @@ fn end_rotation(
     if e.euler_branch == EulerBranch::AsWritten {
         return Ok(None);
     }
-    use crate::layout::Field;
+    use crate::rod::layout::Field;
     let get = |fld| angles.iter().find(|(g, _)| *g == fld).map(|x| x.1);
     let full = if spatial {
         match (get(Field::Phi), get(Field::Theta), get(Field::Psi)) {
             (Some(phi), Some(theta), Some(psi)) => {
-                Some((crate::kinematics::rotation(phi, theta, psi), Some(phi)))
+                Some((crate::rod::kinematics::rotation(phi, theta, psi), Some(phi)))
             }
             _ => None,
         }
@@ -490,9 +490,9 @@ pub fn plan_options(case: &Case) -> Result<PlanOptions, Error> {
         }
         let mut angles = Vec::new();
         for (nm, fld, val) in [
-            ("phi", crate::layout::Field::Phi, e.phi),
-            ("theta", crate::layout::Field::Theta, e.theta),
-            ("psi", crate::layout::Field::Psi, e.psi),
+            ("phi", crate::rod::layout::Field::Phi, e.phi),
+            ("theta", crate::rod::layout::Field::Theta, e.theta),
+            ("psi", crate::rod::layout::Field::Psi, e.psi),
         ] {
             let Some(val) = val else { continue };
             if layout.offset(fld).is_none() {

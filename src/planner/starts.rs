@@ -8,8 +8,8 @@ use super::observer::PlanObserver;
 use super::optimise::noise;
 use super::refine::Verified;
 use super::verify::{Verification, verify_with};
-use crate::model::Model;
-use crate::path::DeformationPath;
+use crate::planner::path::DeformationPath;
+use crate::rod::model::Model;
 use std::borrow::Cow;
 
 /// One start's verified plan and the path-term count it was planned with.

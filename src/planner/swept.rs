@@ -19,9 +19,9 @@
 //! where a point does not move (the clamped base).
 
 use crate::constraints::{Adjoint, Constraint};
-use crate::kinematics::Shape;
-use crate::model::Model;
-use crate::path::DeformationPath;
+use crate::planner::path::DeformationPath;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 
 /// Smoothing length of `|Δ|` (units of `L`).
 pub const DELTA: f64 = 1e-4;
@@ -242,7 +242,7 @@ impl Swept {
                             }
                         }
                         g.iter_mut().for_each(|v| *v *= 0.5);
-                        crate::hessian::add_rank_one(h, sr, &g);
+                        crate::rod::hessian::add_rank_one(h, sr, &g);
                     }
                 }
             }
@@ -252,7 +252,7 @@ impl Swept {
 
 #[cfg(test)]
 mod tests {
-    use crate::obstacle::{Obstacle, ObstacleShape};
+    use crate::scene::obstacle::{Obstacle, ObstacleShape};
     use parry3d_f64::shape::Cuboid;
 
     /// The bound behind the rows: wherever `(d(p) + d(q) − |q − p|)/2 ≥ c`, every point of the

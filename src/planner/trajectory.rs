@@ -7,9 +7,9 @@
 //! `η` and the tangent `ζ`. A robot whose base frame `B` sees the case frame at rotation `R_B`
 //! and origin `t_B` commands `p_B = R_B p + t_B` and `q_B = q(R_B) ⊗ q`.
 
-use crate::kinematics::Shape;
-use crate::model::Model;
-use crate::path::DeformationPath;
+use crate::planner::path::DeformationPath;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
 use serde::Serialize;
 
 /// One pose of an end of the rod.
@@ -277,7 +277,7 @@ impl Trajectory {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::rotation;
+    use crate::rod::kinematics::rotation;
 
     #[test]
     fn quaternion_and_matrix_round_trip() {

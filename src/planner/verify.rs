@@ -2,11 +2,11 @@
 //! energy and the worst clearance to every obstacle. A path that tunnels through an obstacle
 //! between the optimiser's samples shows up here as a negative clearance.
 
-use crate::energy::Objective;
-use crate::kinematics::Shape;
-use crate::model::{Discretisation, Model};
-use crate::obstacle::Obstacle;
-use crate::path::DeformationPath;
+use crate::planner::path::DeformationPath;
+use crate::rod::energy::Objective;
+use crate::rod::kinematics::Shape;
+use crate::rod::model::{Discretisation, Model};
+use crate::scene::obstacle::Obstacle;
 use serde::Serialize;
 use std::sync::Arc;
 

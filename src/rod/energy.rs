@@ -6,9 +6,9 @@
 //! - extension `½∫ Re ε²` (eq. 10)
 //! - gravity  `∫ D x ds` (eq. 11), evaluated by parts as `x(0)·∫D + ∫ (1+ε) ζₓ(t) ∫ₜᴸ D`.
 
-use crate::kinematics::Shape;
-use crate::layout::Field;
-use crate::model::Model;
+use crate::rod::kinematics::Shape;
+use crate::rod::layout::Field;
+use crate::rod::model::Model;
 use serde::Serialize;
 
 /// The energy terms of one shape.
@@ -79,7 +79,7 @@ impl Model {
         energy_terms(self, a, shape, objective, grad)
     }
 
-    /// [`Model::energy`]'s loops (compiled twice, see [`crate::wide`]).
+    /// [`Model::energy`]'s loops (compiled twice, see [`crate::kernels::wide`]).
     #[inline(always)]
     fn energy_body(
         &self,
@@ -199,7 +199,7 @@ impl Model {
         let mut grad = grad;
         for r in &self.energy_roots {
             let ab = &a[r.offset..r.offset + r.row.len()];
-            let v = crate::basis::dot(&r.row, ab);
+            let v = crate::rod::basis::dot(&r.row, ab);
             if r.flexural {
                 t.flexural += 0.5 * v * v;
             } else {
@@ -228,7 +228,7 @@ impl Model {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn energy_terms(
         m: &Model,
         a: &[f64],

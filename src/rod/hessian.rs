@@ -8,10 +8,10 @@
 //! Together with [`crate::constraints::Adjoint`] this gives the Hessian of a Lagrangian up to
 //! the curvature of the obstacle distance functions themselves (treated as locally flat).
 
-use crate::energy::Objective;
-use crate::kinematics::Shape;
-use crate::layout::Field;
-use crate::model::{LANES, Model};
+use crate::rod::energy::Objective;
+use crate::rod::kinematics::Shape;
+use crate::rod::layout::Field;
+use crate::rod::model::{LANES, Model};
 
 /// Local quantities at a node.
 const TH: usize = 0;
@@ -109,7 +109,7 @@ impl Model {
         energy_hessian(self, shape, objective, scale, h);
     }
 
-    /// [`Model::add_energy_hessian`]'s loops (compiled twice, see [`crate::wide`]).
+    /// [`Model::add_energy_hessian`]'s loops (compiled twice, see [`crate::kernels::wide`]).
     #[inline(always)]
     fn energy_hessian_body(&self, shape: &Shape, objective: Objective, scale: f64, h: &mut [f64]) {
         let spatial = self.layout.spatial;
@@ -176,7 +176,7 @@ impl Model {
         positions_hessian(self, shape, v, h);
     }
 
-    /// [`Model::add_positions_hessian`]'s loops (compiled twice, see [`crate::wide`]).
+    /// [`Model::add_positions_hessian`]'s loops (compiled twice, see [`crate::kernels::wide`]).
     #[inline(always)]
     fn positions_hessian_body(&self, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) {
         // Suffix sums: a node of panel j enters every position after it.
@@ -340,7 +340,7 @@ impl Model {
 
 impl Model {
     /// [`Model::add_positions_gauss_newton`] for a planar inextensible rod with a fixed base
-    /// (compiled twice, see [`crate::wide`]): there `sin φ = 0`, `cos φ = 1` and `ε = 0`, so
+    /// (compiled twice, see [`crate::kernels::wide`]): there `sin φ = 0`, `cos φ = 1` and `ε = 0`, so
     /// the Jacobian's y row is zero and its x and z rows gain `w cos θ eᵢ` and `−w sin θ eᵢ` per
     /// node — the general assembly's products, which it computes as `(w · (1 · cos θ · 1)) eᵢ`
     /// and `(w · (−1 · sin θ)) eᵢ`, the same numbers — and the rank-one updates add the x row's
@@ -372,7 +372,7 @@ impl Model {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn planar_gauss_newton(m: &Model, shape: &Shape, c: &[f64], h: &mut [f64]) => Model::planar_gauss_newton_body
 }
 
@@ -392,10 +392,10 @@ pub fn add_rank_one(h: &mut [f64], w: f64, g: &[f64]) {
 
 #[cfg(test)]
 mod tests {
-    use crate::basis::Basis;
-    use crate::energy::Objective;
-    use crate::layout::Layout;
-    use crate::model::{Discretisation, Model, PointLoad};
+    use crate::rod::basis::Basis;
+    use crate::rod::energy::Objective;
+    use crate::rod::layout::Layout;
+    use crate::rod::model::{Discretisation, Model, PointLoad};
     use crate::rod::{Profile, Rod};
 
     fn model(spatial: bool, extensible: bool) -> Model {
@@ -456,7 +456,7 @@ mod tests {
     /// three components of the tangent).
     fn framed() -> Model {
         free_based()
-            .with_frame(crate::kinematics::rotation(0.4, 1.1, -0.7))
+            .with_frame(crate::rod::kinematics::rotation(0.4, 1.1, -0.7))
             .expect("a rotation")
     }
 
@@ -642,10 +642,10 @@ mod tests {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn positions_hessian(m: &Model, shape: &Shape, v: &[[f64; 3]], h: &mut [f64]) => Model::positions_hessian_body
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn energy_hessian(m: &Model, shape: &Shape, objective: Objective, scale: f64, h: &mut [f64]) => Model::energy_hessian_body
 }

@@ -2,8 +2,8 @@
 //! `(1+ε)ζ` (eq. 5), positions by cumulative quadrature (eq. 6), frames (eq. 1), and
 //! vector–Jacobian products `Σ_b v_b · ∂x(b)/∂a` computed in one backward pass.
 
-use crate::layout::Field;
-use crate::model::{LANES, Model};
+use crate::rod::layout::Field;
+use crate::rod::model::{LANES, Model};
 
 /// A shape evaluated at the quadrature nodes, with positions at the mesh boundaries.
 #[derive(Clone, Debug, Default)]
@@ -142,7 +142,7 @@ impl Model {
         positions_vjp(self, shape, v, grad);
     }
 
-    /// [`Model::add_positions_vjp`]'s loops (compiled twice, see [`crate::wide`]).
+    /// [`Model::add_positions_vjp`]'s loops (compiled twice, see [`crate::kernels::wide`]).
     #[inline(always)]
     fn positions_vjp_body(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
         let lay = &self.layout;
@@ -316,7 +316,7 @@ impl Model {
         let x0 = shape.positions[j];
         let mut x = if self.frame.is_some() { [0.0; 3] } else { x0 };
         let t0 = self.mesh.boundaries[j];
-        let (gx, gw) = crate::quadrature::gauss_legendre(8);
+        let (gx, gw) = crate::rod::quadrature::gauss_legendre(8);
         let h = t - t0;
         for (xi, wi) in gx.iter().zip(&gw) {
             let u = t0 + 0.5 * h * (xi + 1.0);
@@ -335,27 +335,27 @@ impl Model {
     }
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn evaluate_nodes(m: &Model, a: &[f64], shape: &mut Shape) => evaluate_nodes_body
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn evaluate_fields(m: &Model, a: &[f64], shape: &mut Shape) -> bool => evaluate_fields_body
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn planar_sums_4(m: &Model, shapes: [&mut Shape; 4]) => planar_sums_body
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn planar_sums_1(m: &Model, shapes: [&mut Shape; 1]) => planar_sums_body
 }
 
-crate::wide::dispatch! {
+crate::kernels::wide::dispatch! {
     fn positions_vjp(m: &Model, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) => Model::positions_vjp_body
 }
 
-/// [`Model::evaluate_into`]'s loops (compiled twice, see [`crate::wide`]).
+/// [`Model::evaluate_into`]'s loops (compiled twice, see [`crate::kernels::wide`]).
 #[inline(always)]
 fn evaluate_nodes_body(m: &Model, a: &[f64], shape: &mut Shape) {
     if evaluate_fields_body(m, a, shape) {
@@ -456,11 +456,11 @@ fn evaluate_fields_body(m: &Model, a: &[f64], shape: &mut Shape) -> bool {
     if curvature {
         rows(at, &m.de_rows, &mut shape.dth);
     }
-    crate::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
+    crate::kernels::trig::sin_cos_slice(&shape.th, &mut shape.sth, &mut shape.cth);
     if let Some(ap) = ap {
         rows(ap, &m.e_rows, &mut shape.ph);
         rows(ap, &m.de_rows, &mut shape.dph);
-        crate::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
+        crate::kernels::trig::sin_cos_slice(&shape.ph, &mut shape.sph, &mut shape.cph);
     }
     if let Some(aps) = aps {
         rows(aps, &m.de_rows, &mut shape.dps);
@@ -511,6 +511,17 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// `Rᵀ m`: rotation `m` of the case's axes written in frame `r` (row-major); `None` is the
+/// identity, which leaves `m` as it is.
+pub fn in_frame(r: Option<&[[f64; 3]; 3]>, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    match r {
+        None => m,
+        Some(r) => std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..3).map(|k| r[k][i] * m[k][j]).sum())
+        }),
+    }
 }
 
 /// Whether `r` (row-major) is a proper rotation: orthonormal columns to `tol` and determinant

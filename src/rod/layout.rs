@@ -4,7 +4,7 @@
 //! base position `x(0)` when it is free (`x, z` for planar rods, `x, y, z` for spatial ones).
 //! A planar rod (`φ = ψ = 0`) carries only the `θ` coefficients.
 
-use crate::basis::Basis;
+use crate::rod::basis::Basis;
 
 /// One of the four functions of arc length that describe a shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +33,17 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The layout for `rod` with `pairs` sine–cosine pairs of the paper's basis: 3D when the
+    /// rod has a torsional rigidity, extensible when it has an extensional one, base fixed.
+    pub fn of(rod: &crate::rod::Rod, pairs: usize) -> Layout {
+        Layout {
+            basis: Basis::new(pairs),
+            spatial: rod.torsional.is_some(),
+            extensible: rod.extensional.is_some(),
+            free_base: false,
+        }
+    }
+
     /// Number of coefficients of one field.
     pub fn nb(&self) -> usize {
         self.basis.len()

@@ -73,6 +73,43 @@ pub struct Rod {
 }
 
 impl Rod {
+    /// A uniform rod of `length` with flexural rigidity `rf`, as a case file's defaults make it:
+    /// no torsional rigidity (planar), inextensible, weightless, of radius `length / 1000`.
+    pub fn uniform(length: f64, rf: f64) -> Rod {
+        Rod {
+            length,
+            flexural: Profile::Constant(rf),
+            torsional: None,
+            extensional: None,
+            weight: Profile::Constant(0.0),
+            radius: length / 1000.0,
+        }
+    }
+
+    /// The same rod with torsional rigidity `rt` (needed by a 3D rod).
+    pub fn with_torsional_rigidity(mut self, rt: f64) -> Rod {
+        self.torsional = Some(Profile::Constant(rt));
+        self
+    }
+
+    /// The same rod, extensible with rigidity `re`.
+    pub fn with_extensional_rigidity(mut self, re: f64) -> Rod {
+        self.extensional = Some(Profile::Constant(re));
+        self
+    }
+
+    /// The same rod with weight `w` per unit length (gravity along `−x`).
+    pub fn with_weight(mut self, w: f64) -> Rod {
+        self.weight = Profile::Constant(w);
+        self
+    }
+
+    /// The same rod with cross-section radius `r`.
+    pub fn with_radius(mut self, r: f64) -> Rod {
+        self.radius = r;
+        self
+    }
+
     /// Reference flexural rigidity used for scaling: the mean of `Rf`.
     pub fn rf_ref(&self) -> f64 {
         self.flexural.mean()

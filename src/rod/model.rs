@@ -6,9 +6,9 @@
 //! material functions are then `Rf(s)/Rf`, `Rt(s)/Rf` (ρt), `Re(s) L²/Rf` (ρe) and
 //! `D(s) L³/Rf` (ρg).
 
-use crate::layout::{Field, Layout};
-use crate::quadrature::Mesh;
 use crate::rod::Rod;
+use crate::rod::layout::{Field, Layout};
+use crate::rod::quadrature::Mesh;
 
 /// A point force `p` applied at `s` (paper eq. 12): it does work `p · (x(s) − x_ref)`.
 #[derive(Clone, Debug, PartialEq)]
@@ -217,7 +217,7 @@ impl Model {
     /// 3D rod can take one other than the identity; `None` if `R` is refused.
     pub fn with_frame(mut self, r: [[f64; 3]; 3]) -> Option<Model> {
         let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
-        if !crate::kinematics::is_rotation(r, 1e-12) || !(self.layout.spatial || identity) {
+        if !crate::rod::kinematics::is_rotation(r, 1e-12) || !(self.layout.spatial || identity) {
             return None;
         }
         self.frame = (!identity).then_some(r);
@@ -266,12 +266,7 @@ impl Model {
 
     /// `Rᵀ m`: a rotation in the case's axes, written in the angles' frame.
     pub fn rotation_to_angles(&self, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
-        match &self.frame {
-            None => m,
-            Some(r) => std::array::from_fn(|i| {
-                std::array::from_fn(|j| (0..3).map(|k| r[k][i] * m[k][j]).sum())
-            }),
-        }
+        crate::rod::kinematics::in_frame(self.frame.as_ref(), m)
     }
 
     /// Number of unknowns.

@@ -235,7 +235,7 @@ mod tests {
 
     /// The unit cube, outward (counter-clockwise seen from outside), 12 triangles.
     fn cube() -> MeshData {
-        read_obj(include_str!("../planning_cases/meshes/cube.obj")).unwrap()
+        read_obj(include_str!("../../planning_cases/meshes/cube.obj")).unwrap()
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! uses point projection with the inside flag. Half-spaces are evaluated analytically (parry's
 //! contact query mishandles a half-space as second shape). A triangle mesh must be closed and
 //! consistently oriented (built with `ORIENTED`) for inside points to be recognised;
-//! [`crate::mesh::check_solid`] checks that.
+//! [`crate::scene::mesh::check_solid`] checks that.
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::PointQuery;

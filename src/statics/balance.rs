@@ -14,8 +14,8 @@
 //! where the rod's tangent passes through ±z between its ends (θ = 0 or π, where φ and ψ enter
 //! only as φ ∓ ψ): the parametrisation holds the tangent at the pole like a hidden support.
 
-use crate::kinematics::{Shape, cross};
-use crate::problem::StaticProblem;
+use crate::rod::kinematics::{Shape, cross};
+use crate::statics::problem::StaticProblem;
 use crate::statics::{Reaction, point_forces};
 use serde::Serialize;
 

@@ -2,10 +2,11 @@
 //! over the Ritz coefficients subject to the geometric constraints of §3.2.
 
 use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
-use crate::energy::{EnergyTerms, Objective};
-use crate::kinematics::Shape;
-use crate::model::Model;
 use crate::optim::{Nlp, Sense};
+use crate::rod::energy::{EnergyTerms, Objective};
+use crate::rod::kinematics::Shape;
+use crate::rod::layout::{Field, Layout};
+use crate::rod::model::Model;
 
 /// The rod model plus its constraints.
 #[derive(Clone, Debug)]
@@ -63,6 +64,12 @@ impl StaticProblem {
     /// Shape at the last evaluated point.
     pub fn shape(&self) -> &Shape {
         &self.shape
+    }
+
+    /// A start for a solve: the natural state (straight along the angles' frame's z) at the
+    /// base, bent by a deterministic perturbation of `delta` radians (see [`default_start`]).
+    pub fn natural_start(&self, delta: f64) -> Vec<f64> {
+        default_start(&self.model.layout, delta, self.model.base)
     }
 
     /// The constraint block violated most at `a` (label and violation in units of L), if any
@@ -146,4 +153,32 @@ impl Nlp for StaticProblem {
         self.adj.finish_hessian(model, shape, h);
         add_penalty_gauss_newton(blocks, offsets, model, x, shape, s, &mut self.adj, h);
     }
+}
+
+/// The natural state plus a deterministic perturbation of size `delta` radians: a bulge
+/// `θ = δ(1 − 2t)` plus small multiples of the other modes, so that no symmetry of the problem
+/// survives (a symmetric start converges to a symmetric, possibly unstable, equilibrium).
+pub fn default_start(layout: &Layout, delta: f64, base: [f64; 3]) -> Vec<f64> {
+    let mut a = vec![0.0; layout.len()];
+    let nb = layout.nb();
+    a[0] = delta;
+    a[1] = -2.0 * delta;
+    for (i, ai) in a.iter_mut().enumerate().take(nb).skip(2) {
+        *ai = delta * 0.05 * (1.0 + (i as f64 * 0.7).sin());
+    }
+    if let Some(o) = layout.offset(Field::Phi) {
+        a[o] = 0.3;
+        for i in 2..nb {
+            a[o + i] = delta * 0.05 * (i as f64 * 1.3).cos();
+        }
+    }
+    if let Some(o) = layout.offset(Field::Psi) {
+        a[o] = -0.3;
+    }
+    if let Some(o) = layout.base_offset() {
+        for (k, &c) in layout.components().iter().enumerate() {
+            a[o + k] = base[c];
+        }
+    }
+    a
 }

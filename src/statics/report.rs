@@ -1,8 +1,8 @@
 //! Machine-readable summaries of solves, shared by the CLI's `--json` output and tests.
 
-use crate::energy::EnergyTerms;
-use crate::kinematics::angles_of;
-use crate::problem::StaticProblem;
+use crate::rod::energy::EnergyTerms;
+use crate::rod::kinematics::angles_of;
+use crate::statics::problem::StaticProblem;
 use crate::statics::{Reaction, StaticSolution};
 use serde::Serialize;
 
@@ -85,7 +85,7 @@ pub struct ShapeReport {
     /// Reactions at each constraint (force and moment on the rod, case units).
     pub reactions: Vec<Reaction>,
     /// Global moment balance of the reactions, loads and gravity.
-    pub balance: crate::balance::Balance,
+    pub balance: crate::statics::balance::Balance,
     /// Where the rod touches itself, largest force first (empty without self-contact).
     pub self_contacts: Vec<crate::statics::SelfContactForce>,
     /// Largest constraint violation (positions in units of `L`).
@@ -95,7 +95,7 @@ pub struct ShapeReport {
     /// `true` stable, `false` unstable, `null` marginal or not computed.
     pub stable: Option<bool>,
     /// `"stable"`, `"unstable"` or `"marginal"`; `null` if not computed.
-    pub stability: Option<crate::stability::Verdict>,
+    pub stability: Option<crate::statics::stability::Verdict>,
     /// Smallest reduced-Hessian eigenvalue against the fields' Gram matrix (units of `Rf/L`).
     pub min_reduced_eigenvalue: Option<f64>,
     /// Eigenvalues within the verdict's resolution of zero.
@@ -119,7 +119,7 @@ pub struct ShapeReport {
 
 /// Coefficients as a JSON object keyed by field, in the case file's `shape` format.
 pub fn coefficients_json(p: &StaticProblem, a: &[f64]) -> serde_json::Value {
-    use crate::layout::Field;
+    use crate::rod::layout::Field;
     let lay = &p.model.layout;
     let mut m = serde_json::Map::new();
     for (nm, f) in [

@@ -1,12 +1,12 @@
-//! Static shapes (paper §4): the multiplier method around BFGS on a [`StaticProblem`], with the
-//! multipliers turned into reaction forces and moments, and a stability verdict.
+//! The static solve: the multiplier method on a [`StaticProblem`], with the multipliers turned
+//! into reaction forces and moments, and a stability verdict.
 
 use crate::constraints::Angle;
-use crate::energy::EnergyTerms;
-use crate::kinematics::{Shape, rotation};
-use crate::layout::Field;
 use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
-use crate::problem::StaticProblem;
+use crate::rod::energy::EnergyTerms;
+use crate::rod::kinematics::{Shape, rotation};
+use crate::rod::layout::Field;
+use crate::statics::problem::StaticProblem;
 use serde::Serialize;
 
 /// How a static solve ended.
@@ -18,7 +18,7 @@ pub struct StaticOptions {
     /// Multiplier-method settings.
     pub al: AlOptions,
     /// Whether to compute the stability verdict (one Hessian: analytic where exact, else `2n`
-    /// gradient evaluations; see [`crate::stability`]).
+    /// gradient evaluations; see [`crate::statics::stability`]).
     pub stability: bool,
 }
 
@@ -99,16 +99,16 @@ pub struct StaticSolution {
     /// Reactions at each constraint.
     pub reactions: Vec<Reaction>,
     /// The global moment balance of the reactions, loads and gravity.
-    pub balance: crate::balance::Balance,
+    pub balance: crate::statics::balance::Balance,
     /// Where the rod touches itself and how hard (largest first; empty without self-contact).
     pub self_contacts: Vec<SelfContactForce>,
     /// `Some(true)` stable, `Some(false)` unstable, `None` marginal or not computed (see
     /// [`StaticSolution::stability`]).
     pub stable: Option<bool>,
     /// The verdict: stable, unstable or marginal (`None` if not computed).
-    pub stability: Option<crate::stability::Verdict>,
+    pub stability: Option<crate::statics::stability::Verdict>,
     /// Smallest eigenvalue of the reduced Hessian against the fields' Gram matrix (units of
-    /// `Rf/L`; see [`crate::stability`]), if computed.
+    /// `Rf/L`; see [`crate::statics::stability`]), if computed.
     pub min_reduced_eigenvalue: Option<f64>,
     /// Eigenvalues within the verdict's resolution of zero: directions along which the
     /// second-order check cannot decide.
@@ -147,11 +147,11 @@ fn finish(
     opts: &StaticOptions,
 ) -> StaticSolution {
     let judged = (opts.stability && out.status != AlStatus::NumericalFailure)
-        .then(|| crate::stability::judge(p, &a, &out.lambda));
+        .then(|| crate::statics::stability::judge(p, &a, &out.lambda));
     let verdict = judged.map(|j| j.verdict);
     let stable = match verdict {
-        Some(crate::stability::Verdict::Stable) => Some(true),
-        Some(crate::stability::Verdict::Unstable) => Some(false),
+        Some(crate::statics::stability::Verdict::Stable) => Some(true),
+        Some(crate::statics::stability::Verdict::Unstable) => Some(false),
         _ => None,
     };
     let mut c = vec![0.0; crate::optim::Nlp::m(p)];
@@ -159,7 +159,7 @@ fn finish(
     let energy_scaled = p.terms();
     let shape = p.model.evaluate(&a);
     let reactions = reactions(p, &a, &shape, &out.lambda);
-    let balance = crate::balance::balance(p, &a, &shape, &out.lambda, &reactions);
+    let balance = crate::statics::balance::balance(p, &a, &shape, &out.lambda, &reactions);
     let self_contacts = self_contacts(p, &shape, &out.lambda);
     StaticSolution {
         balance,
@@ -188,7 +188,7 @@ fn finish(
 /// `reported` says whether the constraint's [`Reaction`] counts the force (a relative-position
 /// reaction is its force at the second point; the opposite force at the first is not).
 pub(crate) fn point_forces(
-    m: &crate::model::Model,
+    m: &crate::rod::model::Model,
     shape: &Shape,
     con: &crate::constraints::Constraint,
     lam: &[f64],
@@ -315,7 +315,7 @@ pub fn reactions(p: &StaticProblem, a: &[f64], shape: &Shape, lambda: &[f64]) ->
 /// Minimum-norm moment `M` with `M·z = τ_φ`, `M·(Rz(φ)ŷ) = τ_θ`, `M·ζ = τ_ψ` for the prescribed
 /// angles (the axes about which each Euler angle rotates the frame).
 fn least_squares_moment(
-    m: &crate::model::Model,
+    m: &crate::rod::model::Model,
     a: &[f64],
     oc: &crate::constraints::OrientationConstraint,
     torques: [f64; 3],
@@ -367,7 +367,7 @@ pub fn evaluate_shape(p: &mut StaticProblem, a: &[f64]) -> Evaluation {
         lambda: lambda.clone(),
         energy: terms.scaled(p.model.rod.energy_unit()),
         max_violation: viol,
-        balance: crate::balance::balance(p, a, &shape, &lambda, &reactions),
+        balance: crate::statics::balance::balance(p, a, &shape, &lambda, &reactions),
         self_contacts: self_contacts(p, &shape, &lambda),
         reactions,
         kkt_residual: kkt,
@@ -387,7 +387,7 @@ pub struct Evaluation {
     /// KKT residual (dimensionless).
     pub kkt_residual: f64,
     /// Global moment balance.
-    pub balance: crate::balance::Balance,
+    pub balance: crate::statics::balance::Balance,
     /// Self-contact forces, largest first.
     pub self_contacts: Vec<SelfContactForce>,
     /// The least-squares multipliers (dimensionless, one per constraint row).

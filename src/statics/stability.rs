@@ -14,9 +14,9 @@
 //! move nothing. Such a pole stretch also hides bending perturbations the angles cannot express,
 //! so a shape with one is never called stable.
 
-use crate::layout::Field;
 use crate::optim::second_order::{lagrangian_hessian_and_tangents, null_space};
-use crate::problem::StaticProblem;
+use crate::rod::layout::Field;
+use crate::statics::problem::StaticProblem;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 

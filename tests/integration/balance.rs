@@ -1,4 +1,4 @@
-//! The global moment balance of static shapes (`src/balance.rs`): the reactions, loads and
+//! The global moment balance of static shapes (`src/statics/balance.rs`): the reactions, loads and
 //! gravity the report gives must have zero total moment. Exact (to rounding) for planar rods,
 //! whose Ritz space contains every rigid rotation in their plane; for a 3D rod it measures the
 //! Ritz truncation and shrinks as the basis grows.

@@ -78,7 +78,10 @@ fn a_solve_started_on_a_stable_equilibrium_stays_on_it() {
 
 /// The verdict on the straight twisted rod, an equilibrium at every Φ (multipliers by least
 /// squares).
-fn verdict_of_straight(phi: f64, pairs: usize) -> (dlo_planner::stability::Stability, f64) {
+fn verdict_of_straight(
+    phi: f64,
+    pairs: usize,
+) -> (dlo_planner::statics::stability::Stability, f64) {
     verdict_of_straight_in(phi, pairs, "paper")
 }
 
@@ -87,7 +90,7 @@ fn verdict_of_straight_in(
     phi: f64,
     pairs: usize,
     basis: &str,
-) -> (dlo_planner::stability::Stability, f64) {
+) -> (dlo_planner::statics::stability::Stability, f64) {
     let c = greenhill_in(phi, pairs, "", basis);
     let mut p = c.problem.clone();
     let a = c.initial.clone();
@@ -102,7 +105,10 @@ fn verdict_of_straight_in(
         1e-7,
     )
     .unwrap();
-    (dlo_planner::stability::judge(&mut p, &a, &lambda), kkt)
+    (
+        dlo_planner::statics::stability::judge(&mut p, &a, &lambda),
+        kkt,
+    )
 }
 
 /// The twist at which the verdict's smallest eigenvalue changes sign (bisection on
@@ -141,7 +147,7 @@ fn the_verdict_changes_sign_at_greenhills_threshold() {
             "{threshold} after {previous}"
         );
         previous = threshold;
-        use dlo_planner::stability::Verdict;
+        use dlo_planner::statics::stability::Verdict;
         assert_eq!(
             verdict_of_straight(threshold * 0.999, pairs).0.verdict,
             Verdict::Stable
@@ -160,7 +166,7 @@ fn the_verdict_changes_sign_at_greenhills_threshold() {
 /// to 1e-10, x(L) to 1e-9); at 1.01 it is unstable.
 #[test]
 fn legendre_basis_locates_greenhills_threshold() {
-    use dlo_planner::stability::Verdict;
+    use dlo_planner::statics::stability::Verdict;
     for (pairs, tol) in [(3, 2e-3), (4, 2e-5)] {
         // Rounding of the least-squares multipliers: the polynomials' derivative rows reach
         // k(k+1) at the ends, against 2πk for the paper's.

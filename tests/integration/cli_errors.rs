@@ -580,7 +580,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     assert!(err.contains("tunnels.json"), "{err}");
     log_ok("tunnels");
 
-    // A buckled arch planned to a turned end: the replay snaps through (tests/planner.rs).
+    // A buckled arch planned to a turned end: the replay snaps through (tests/integration/planner.rs).
     let snap = dir.join("snap.json");
     std::fs::write(
         &snap,

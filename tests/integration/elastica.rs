@@ -92,7 +92,7 @@ fn clamped_load_is_four_times_pinned() {
         }),
         clamp(&model, 1.0),
     ];
-    let mut p = dlo_planner::problem::StaticProblem::new(model, c);
+    let mut p = dlo_planner::statics::problem::StaticProblem::new(model, c);
     let mut a0 = vec![0.0; p.model.n()];
     a0[2] = 0.1;
     let sol = solve_static(&mut p, &a0, &StaticOptions::default());

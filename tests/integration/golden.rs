@@ -3,7 +3,7 @@
 //! with its timings and file paths removed, compared exactly with `tests/golden/`. A change
 //! meant to keep behaviour keeps them identical; a change meant to alter it regenerates them
 //!
-//!     DLO_UPDATE_GOLDEN=1 cargo test --release --test golden
+//!     DLO_UPDATE_GOLDEN=1 cargo test --release --test integration golden::
 //!
 //! and the diff of `tests/golden/` is reviewed with it.
 
@@ -71,7 +71,7 @@ fn shipped_reports_match_the_golden_files() {
     }
     assert!(
         changed.is_empty(),
-        "reports differ from tests/golden/: {changed:?} (a change meant to alter them: DLO_UPDATE_GOLDEN=1 cargo test --release --test golden, and review the diff)"
+        "reports differ from tests/golden/: {changed:?} (a change meant to alter them: DLO_UPDATE_GOLDEN=1 cargo test --release --test integration golden::, and review the diff)"
     );
     assert!(update || compared >= 26, "{compared} reports compared");
 }

@@ -2,17 +2,17 @@
 //! Jacobian, on random coefficients, planar and 3D (the contract every constraint must pass).
 
 use crate::common;
-use dlo_planner::basis::Basis;
 use dlo_planner::constraints::*;
-use dlo_planner::energy::Objective;
-use dlo_planner::kinematics::Shape;
-use dlo_planner::layout::{Field, Layout};
-use dlo_planner::mesh::read_obj;
-use dlo_planner::model::{Discretisation, Model, PointLoad};
-use dlo_planner::obstacle::{Obstacle, ObstacleShape};
 use dlo_planner::optim::Nlp;
-use dlo_planner::problem::StaticProblem;
+use dlo_planner::rod::basis::Basis;
+use dlo_planner::rod::energy::Objective;
+use dlo_planner::rod::kinematics::Shape;
+use dlo_planner::rod::layout::{Field, Layout};
+use dlo_planner::rod::model::{Discretisation, Model, PointLoad};
 use dlo_planner::rod::{Profile, Rod};
+use dlo_planner::scene::mesh::read_obj;
+use dlo_planner::scene::obstacle::{Obstacle, ObstacleShape};
+use dlo_planner::statics::problem::StaticProblem;
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::*;
 use std::sync::Arc;

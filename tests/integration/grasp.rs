@@ -130,7 +130,7 @@ fn split_problem_gradient_matches_finite_differences() {
         .map(|(i, v)| v + 0.02 * ((i as f64) * 0.7).sin())
         .collect();
     let y: Vec<f64> = (0..m).map(|i| 0.5 + 0.1 * i as f64).collect();
-    let lag = |p: &mut dlo_planner::problem::StaticProblem, x: &[f64]| {
+    let lag = |p: &mut dlo_planner::statics::problem::StaticProblem, x: &[f64]| {
         let mut c = vec![0.0; m];
         let f = p.values(x, &mut c);
         f + y.iter().zip(&c).map(|(u, v)| u * v).sum::<f64>()
@@ -173,7 +173,7 @@ fn split_shape_is_continuous_with_a_shear_jump() {
     let nb = basis.len();
     let half = nb / 2;
     let th = &sol.a[..nb];
-    let unsplit = dlo_planner::basis::Basis::new(basis.pairs());
+    let unsplit = dlo_planner::rod::basis::Basis::new(basis.pairs());
     let left = |t: f64| unsplit.eval(&th[..half], t);
     let right = |t: f64| {
         let r: Vec<f64> = (0..half).map(|i| th[i] + th[half + i]).collect();

@@ -8,9 +8,9 @@
 //! cases from fixed seeds, so a failure names the batch that reproduces it.
 
 use crate::common;
-use dlo_planner::mcap_log::inspect::inspect;
-use dlo_planner::mcap_log::reader::check_finished;
-use dlo_planner::mcap_log::recover::recover;
+use dlo_planner::output::mcap_log::inspect::inspect;
+use dlo_planner::output::mcap_log::reader::check_finished;
+use dlo_planner::output::mcap_log::recover::recover;
 use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;
@@ -121,7 +121,7 @@ fn check(base: &[u8], messages: u64, damaged: &[u8]) -> Result<(), TestCaseError
         let again = inspect(&fixed).unwrap();
         prop_assert_eq!(again.messages, r.messages);
     }
-    let _ = dlo_planner::plot::read_frames(damaged);
+    let _ = dlo_planner::output::plot::read_frames(damaged);
     prop_assert_eq!(check_finished(damaged).is_ok(), !changed);
     Ok(())
 }

@@ -1,10 +1,10 @@
 //! Invariants of the model: a straight rod stores no elastic energy, and elastic energy does
 //! not change under a rigid motion of the base.
 
-use dlo_planner::basis::Basis;
-use dlo_planner::energy::Objective;
-use dlo_planner::layout::{Field, Layout};
-use dlo_planner::model::{Discretisation, Model};
+use dlo_planner::rod::basis::Basis;
+use dlo_planner::rod::energy::Objective;
+use dlo_planner::rod::layout::{Field, Layout};
+use dlo_planner::rod::model::{Discretisation, Model};
 use dlo_planner::rod::{Profile, Rod};
 
 fn rod() -> Rod {
@@ -146,7 +146,7 @@ fn a_free_twist_angle_is_removed_as_one_gauge_mode() {
 /// inextensible and 3D extensible rods, shapes reused from other coefficients.
 #[test]
 fn evaluate_many_matches_evaluate_into_bit_for_bit() {
-    use dlo_planner::kinematics::Shape;
+    use dlo_planner::rod::kinematics::Shape;
     let planar = Model::new(
         rod(),
         Layout {
@@ -211,7 +211,7 @@ fn reported_end_pose_meets_its_constraint_and_planar_y_zero_is_accepted() {
         let a0 = c.initial.clone();
         let sol = dlo_planner::statics::solve_static(&mut c.problem, &a0, &c.options);
         assert!(sol.max_violation < 1e-12);
-        let r = dlo_planner::report::ShapeReport::solved(
+        let r = dlo_planner::statics::report::ShapeReport::solved(
             &c.name,
             &c.problem,
             &sol,

@@ -4,8 +4,8 @@
 //! reference Python reader (`.ci/run`).
 
 use dlo_planner::case;
-use dlo_planner::mcap_log::recover::recover;
-use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter};
+use dlo_planner::output::mcap_log::recover::recover;
+use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter};
 use dlo_planner::planner::Planner;
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
 use foxglove::Decode;
@@ -28,17 +28,17 @@ struct Counting {
 }
 
 impl PlanObserver for Counting {
-    fn begin(&mut self, m: &dlo_planner::model::Model) {
+    fn begin(&mut self, m: &dlo_planner::rod::model::Model) {
         self.log.begin(m);
     }
     fn phase(&mut self, n: &str) {
         self.log.phase(n);
     }
-    fn shape(&mut self, m: &dlo_planner::model::Model, r: &ShapeRecord) {
+    fn shape(&mut self, m: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
         self.shapes += 1;
         self.log.shape(m, r);
     }
-    fn progress(&mut self, m: &dlo_planner::model::Model, p: &Progress, w: &[f64]) {
+    fn progress(&mut self, m: &dlo_planner::rod::model::Model, p: &Progress, w: &[f64]) {
         self.log.progress(m, p, w);
     }
 }
@@ -135,18 +135,18 @@ fn shape_command_logs_its_solve() {
 fn unfinished_log_is_recovered() {
     let path = log_dir().join("unfinished_unit.mcap");
     let mut w = McapWriter::create(&path).unwrap();
-    let up = dlo_planner::mcap_log::scene::rod_update(
+    let up = dlo_planner::output::mcap_log::scene::rod_update(
         0,
         "rod",
         &[[0.0; 3], [0.0, 0.0, 1.0]],
         0.01,
-        dlo_planner::mcap_log::scene::color(1.0, 0.0, 0.0, 1.0),
+        dlo_planner::output::mcap_log::scene::color(1.0, 0.0, 0.0, 1.0),
     );
     // A scene a viewer can show: the frame transform first, as every log has it.
     w.proto(
         "/tf",
         0,
-        &dlo_planner::mcap_log::scene::gravity_transform(0),
+        &dlo_planner::output::mcap_log::scene::gravity_transform(0),
     )
     .unwrap();
     for i in 0..500u64 {
@@ -213,7 +213,7 @@ fn plan_into_until_first_chunks(dir: &Path) -> (std::process::Child, PathBuf) {
     let t0 = std::time::Instant::now();
     let straight_on_disk = || {
         let bytes = std::fs::read(&log).unwrap_or_default();
-        dlo_planner::mcap_log::inspect::inspect(&bytes)
+        dlo_planner::output::mcap_log::inspect::inspect(&bytes)
             .ok()
             .and_then(|i| i.topics.get("/rod/straight").map(|t| t.messages))
             == Some(41)
@@ -303,7 +303,7 @@ fn plot_writes_an_svg_from_a_log() {
     ] {
         assert!(svg.contains(label), "legend lacks {label}");
     }
-    let c = dlo_planner::plot::ramp(0.01);
+    let c = dlo_planner::output::plot::ramp(0.01);
     let fill = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
     assert!(svg.contains(&fill), "no colour bar ({fill})");
     // A planar case has one view; the paper's case has no y extent.

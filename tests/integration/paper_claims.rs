@@ -298,7 +298,7 @@ fn kinking_energy_falls_as_the_twisted_rod_is_shortened() {
         );
         assert_eq!(
             sol.stability,
-            Some(dlo_planner::stability::Verdict::Marginal)
+            Some(dlo_planner::statics::stability::Verdict::Marginal)
         );
         assert_eq!(sol.stable, None);
         sol.energy.potential()

@@ -5,8 +5,8 @@
 
 use crate::common::{self, shipped_variant};
 use dlo_planner::case;
-use dlo_planner::path::DeformationPath;
 use dlo_planner::planner::observer::Silent;
+use dlo_planner::planner::path::DeformationPath;
 use dlo_planner::planner::verify::{fine_model, verify};
 use dlo_planner::planner::{PlanStatus, Planner};
 use std::path::Path;
@@ -559,7 +559,7 @@ struct Feasible(Vec<(f64, Vec<f64>)>);
 impl dlo_planner::planner::observer::PlanObserver for Feasible {
     fn shape(
         &mut self,
-        _model: &dlo_planner::model::Model,
+        _model: &dlo_planner::rod::model::Model,
         r: &dlo_planner::planner::observer::ShapeRecord,
     ) {
         if r.kind == dlo_planner::planner::observer::PathKind::Feasible {
@@ -817,7 +817,7 @@ impl dlo_planner::planner::observer::PlanObserver for Timeline {
     }
     fn progress(
         &mut self,
-        _model: &dlo_planner::model::Model,
+        _model: &dlo_planner::rod::model::Model,
         p: &dlo_planner::planner::observer::Progress,
         _worst: &[f64],
     ) {
@@ -956,8 +956,8 @@ fn bar_case_3d_coincides() {
     let model = &p.base.model;
     let offset = |f| model.layout.offset(f).unwrap();
     let (op, os) = (
-        offset(dlo_planner::layout::Field::Phi),
-        offset(dlo_planner::layout::Field::Psi),
+        offset(dlo_planner::rod::layout::Field::Phi),
+        offset(dlo_planner::rod::layout::Field::Psi),
     );
     let nb = model.layout.nb();
     let mut a = vec![0.0; path.n()];
@@ -1135,8 +1135,8 @@ fn bar_plan_beats_hand_made_paths_with_its_margin() {
 /// the sum of the steps, at least the straight-line distance.
 #[test]
 fn trajectory_reproduces_the_plans_end_pose() {
-    use dlo_planner::kinematics::rotation;
     use dlo_planner::planner::trajectory::rotation_of_quaternion;
+    use dlo_planner::rod::kinematics::rotation;
     for (p, r) in [paper(), bar()] {
         let model = &p.base.model;
         let l = model.rod.length;
@@ -1204,8 +1204,8 @@ fn trajectory_reproduces_the_plans_end_pose() {
 /// path's interior nearly free). Bad orientations name the field.
 #[test]
 fn equivalent_pose_spellings_give_the_same_plan() {
-    use dlo_planner::kinematics::rotation;
     use dlo_planner::planner::trajectory::quaternion_of;
+    use dlo_planner::rod::kinematics::rotation;
     let same =
         |name: &str, a: &dlo_planner::planner::PlanResult, b: &dlo_planner::planner::PlanResult| {
             assert_eq!(a.status, b.status, "{name}");

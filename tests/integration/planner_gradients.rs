@@ -110,7 +110,7 @@ fn spatial_minimax_gradient_matches_finite_differences() {
 
 #[test]
 fn path_ends_on_its_shapes_and_keeps_linear_conditions() {
-    use dlo_planner::path::DeformationPath;
+    use dlo_planner::planner::path::DeformationPath;
     let a0 = vec![0.0, 1.0, 0.5, -0.2];
     let a1 = vec![0.3, -1.0, 0.1, 0.4];
     // A linear condition on a[1] + a[2]: every path vector must satisfy C cᵢ = 0.
@@ -150,9 +150,9 @@ fn smoothed_max_brackets_the_max() {
 /// circle) crosses itself; one turning by 3 rad does not.
 #[test]
 fn verification_finds_a_rod_crossing_itself() {
-    use dlo_planner::energy::Objective;
-    use dlo_planner::path::DeformationPath;
+    use dlo_planner::planner::path::DeformationPath;
     use dlo_planner::planner::verify::{fine_model, verify_with};
+    use dlo_planner::rod::energy::Objective;
     let text = r#"{ "rod": { "length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005 },
                     "self_contact": true }"#;
     let c = case::parse(text, Path::new("curl.json")).unwrap();

@@ -2,10 +2,10 @@
 
 use dlo_planner::case;
 use dlo_planner::constraints::segment_distance;
-use dlo_planner::layout::Field;
 use dlo_planner::planner::observer::Silent;
 use dlo_planner::planner::verify::{fine_model, verify_with};
 use dlo_planner::planner::{PlanStatus, Planner};
+use dlo_planner::rod::layout::Field;
 use dlo_planner::statics::{SolveStatus, StaticSolution, solve_static};
 use std::path::Path;
 

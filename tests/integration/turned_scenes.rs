@@ -6,7 +6,7 @@
 //! of 10 in energy, which is what the frame removes.
 
 use dlo_planner::case;
-use dlo_planner::kinematics::{angles_of, rotation};
+use dlo_planner::rod::kinematics::{angles_of, rotation};
 use dlo_planner::statics::{SolveStatus, StaticSolution, solve_static};
 use serde_json::{Value, json};
 use std::f64::consts::PI;
@@ -318,7 +318,7 @@ fn reported_coefficients_and_frame_round_trip() {
         .angle_frame()
         .expect("the loop's angles have a frame");
     let mut v: Value = serde_json::from_str(&text).unwrap();
-    v["shape"] = dlo_planner::report::coefficients_json(&c.problem, &sol.a);
+    v["shape"] = dlo_planner::statics::report::coefficients_json(&c.problem, &sol.a);
     v["angle_frame"] = json!(frame);
     let mut back = case::parse(&v.to_string(), Path::new("back.json")).unwrap();
     let a = back.initial.clone();

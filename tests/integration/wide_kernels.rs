@@ -1,4 +1,4 @@
-//! The hot loops run four doubles wide where the processor has AVX2 (`src/wide.rs`). Both
+//! The hot loops run four doubles wide where the processor has AVX2 (`src/kernels/wide.rs`). Both
 //! compilations must give the same results bit for bit: the same plan (every number of the JSON
 //! report but the timings), the same static shapes, the same grasp margins. `DLO_NO_AVX2` forces
 //! the baseline path. On a processor without AVX2 both runs take the baseline path and the test

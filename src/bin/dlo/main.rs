@@ -8,10 +8,10 @@ mod batch;
 
 use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
-use dlo_planner::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
+use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
 use dlo_planner::planner::{PlanStatus, Planner};
-use dlo_planner::report::{ShapeReport, coefficients_json, pose};
+use dlo_planner::statics::report::{ShapeReport, coefficients_json, pose};
 use dlo_planner::statics::{evaluate_shape, solve_static};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -299,7 +299,7 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
     if ACTIVE_LOG.set((shared.clone(), path.clone())).is_ok() {
         let _ = ctrlc::set_handler(|| {
             if let Some((w, path)) = ACTIVE_LOG.get() {
-                let mut w = dlo_planner::mcap_log::lock(w);
+                let mut w = dlo_planner::output::mcap_log::lock(w);
                 if w.finish().is_ok() {
                     let _ = std::fs::rename(partial_path(path), path);
                 }
@@ -315,7 +315,7 @@ fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode>
 /// half-written file.
 fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
     let tmp = partial_path(path);
-    let mut guard = dlo_planner::mcap_log::lock(w);
+    let mut guard = dlo_planner::output::mcap_log::lock(w);
     let was_open = !guard.is_finished();
     let finished = guard.finish().map_err(|e| causes(&e));
     drop(guard);
@@ -458,9 +458,9 @@ fn print_report(r: &ShapeReport, json: bool) {
         let _ = write!(o, ", KKT residual {k:.2e}");
     }
     o.push_str(match r.stability {
-        Some(dlo_planner::stability::Verdict::Stable) => ", stable",
-        Some(dlo_planner::stability::Verdict::Unstable) => ", UNSTABLE",
-        Some(dlo_planner::stability::Verdict::Marginal) => ", stability marginal",
+        Some(dlo_planner::statics::stability::Verdict::Stable) => ", stable",
+        Some(dlo_planner::statics::stability::Verdict::Unstable) => ", UNSTABLE",
+        Some(dlo_planner::statics::stability::Verdict::Marginal) => ", stability marginal",
         None => "",
     });
     if let Some(n @ 1..) = r.neutral_modes {
@@ -527,7 +527,7 @@ struct CliObserver {
 }
 
 impl PlanObserver for CliObserver {
-    fn begin(&mut self, model: &dlo_planner::model::Model) {
+    fn begin(&mut self, model: &dlo_planner::rod::model::Model) {
         self.log.begin(model);
     }
     fn phase(&mut self, name: &str) {
@@ -539,7 +539,7 @@ impl PlanObserver for CliObserver {
             );
         }
     }
-    fn shape(&mut self, model: &dlo_planner::model::Model, r: &ShapeRecord) {
+    fn shape(&mut self, model: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
         self.log.shape(model, r);
         if self.tty && r.kind == dlo_planner::planner::observer::PathKind::Feasible {
             eprint!(
@@ -550,7 +550,7 @@ impl PlanObserver for CliObserver {
             );
         }
     }
-    fn progress(&mut self, model: &dlo_planner::model::Model, p: &Progress, worst: &[f64]) {
+    fn progress(&mut self, model: &dlo_planner::rod::model::Model, p: &Progress, worst: &[f64]) {
         self.log.progress(model, p, worst);
         if self.tty {
             eprint!(
@@ -923,7 +923,7 @@ fn run_recover(broken: &Path, fixed: &Path) -> ExitCode {
             return ExitCode::from(EXIT_OUTPUT);
         }
     };
-    match dlo_planner::mcap_log::recover::recover(&bytes, out) {
+    match dlo_planner::output::mcap_log::recover::recover(&bytes, out) {
         Ok(r) => {
             if let Err(e) = std::fs::rename(&tmp, fixed) {
                 let _ = std::fs::remove_file(&tmp);
@@ -964,7 +964,7 @@ fn run_inspect(file: &Path, json: bool) -> ExitCode {
         Ok(b) => b,
         Err(c) => return c,
     };
-    let ins = match dlo_planner::mcap_log::inspect::inspect(&bytes) {
+    let ins = match dlo_planner::output::mcap_log::inspect::inspect(&bytes) {
         Ok(i) => i,
         Err(e) => {
             eprintln!("error: {}: not an MCAP file: {e}", file.display());
@@ -1017,7 +1017,7 @@ fn run_plot(file: &Path, out: &Path) -> ExitCode {
         Ok(b) => b,
         Err(c) => return c,
     };
-    let frames = match dlo_planner::plot::read_frames(&bytes) {
+    let frames = match dlo_planner::output::plot::read_frames(&bytes) {
         Ok(f) => f,
         Err(e) => {
             eprintln!("error: {}: {e}", file.display());
@@ -1027,7 +1027,7 @@ fn run_plot(file: &Path, out: &Path) -> ExitCode {
     let title = file
         .file_stem()
         .map_or("plan".into(), |s| s.to_string_lossy().into_owned());
-    match dlo_planner::plot::plot(&frames, &title, out) {
+    match dlo_planner::output::plot::plot(&frames, &title, out) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}: {e}", out.display());
@@ -1085,10 +1085,15 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
         eprintln!();
     }
     let fingers = grasp.finger_contacts();
-    let logged =
-        dlo_planner::mcap_log::log_margin(&log, &c.problem.model, &c.obstacles, &fingers, &margin)
-            .map_err(|e| causes(&e))
-            .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
+    let logged = dlo_planner::output::mcap_log::log_margin(
+        &log,
+        &c.problem.model,
+        &c.obstacles,
+        &fingers,
+        &margin,
+    )
+    .map_err(|e| causes(&e))
+    .and_then(|()| close_log(&log, &log_path).map_err(|_| "cannot finish".to_string()));
     if let Err(e) = logged {
         eprintln!("error: {}: cannot write the log: {e}", log_path.display());
         return ExitCode::from(EXIT_OUTPUT);
@@ -1149,7 +1154,7 @@ fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     }
     if plot {
         let svg = log_path.with_extension("svg");
-        if let Err(e) = dlo_planner::plot::plot_margin(
+        if let Err(e) = dlo_planner::output::plot::plot_margin(
             &margin,
             &grasp.initial_points(),
             &fingers,

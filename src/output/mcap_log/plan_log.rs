@@ -27,9 +27,10 @@ use super::scene::{
     wall_clock_ns,
 };
 use super::writer::{LogError, McapWriter};
-use crate::model::Model;
-use crate::obstacle::Obstacle;
+use crate::output::topics;
 use crate::planner::observer::{PathKind, PlanObserver, Progress, ShapeRecord};
+use crate::rod::model::Model;
+use crate::scene::obstacle::Obstacle;
 use serde_json::json;
 use std::fs::File;
 use std::io::BufWriter;
@@ -54,10 +55,10 @@ fn scene_start(
     obstacles: &[Arc<Obstacle>],
     length: f64,
 ) -> Result<(), LogError> {
-    w.proto("/tf", t0, &gravity_transform(t0))?;
+    w.proto(topics::TRANSFORMS, t0, &gravity_transform(t0))?;
     if !obstacles.is_empty() {
         w.proto(
-            "/scene/obstacles",
+            topics::OBSTACLES,
             t0,
             &obstacles_update(t0, obstacles, length),
         )?;
@@ -163,13 +164,15 @@ impl PlanLog {
     }
 }
 
-fn topic(kind: PathKind) -> &'static str {
+/// The rod, end-pose and metrics topics of a kind of path.
+fn topics(kind: PathKind) -> (&'static str, &'static str, &'static str) {
+    use crate::output::topics::*;
     match kind {
-        PathKind::Endpoint => "endpoints",
-        PathKind::Straight => "straight",
-        PathKind::Iterate => "iterate",
-        PathKind::Optimal => "optimal",
-        PathKind::Feasible => "feasible",
+        PathKind::Endpoint => (ROD_ENDPOINTS, "", METRICS_ENDPOINTS),
+        PathKind::Straight => (ROD_STRAIGHT, "", METRICS_STRAIGHT),
+        PathKind::Iterate => (ROD_ITERATE, "", METRICS_ITERATE),
+        PathKind::Optimal => (ROD_OPTIMAL, END_POSE_OPTIMAL, METRICS_OPTIMAL),
+        PathKind::Feasible => (ROD_FEASIBLE, END_POSE_FEASIBLE, METRICS_FEASIBLE),
     }
 }
 
@@ -202,7 +205,7 @@ impl PlanObserver for PlanLog {
     fn shape(&mut self, model: &Model, r: &ShapeRecord) {
         let t = self.t0 + time_of_k(r.k);
         let pts = rod_points(model, r.a);
-        let name = topic(r.kind);
+        let (rod_topic, pose_topic, metrics_topic) = topics(r.kind);
         let thick = rod_thickness(model.rod.radius, model.rod.length);
         // Entity id, colour and thickness: the two end shapes are separate entities (both stay
         // on screen); the plan is a translucent tube with the replay thinner and opaque inside.
@@ -220,16 +223,12 @@ impl PlanObserver for PlanLog {
         let reactions =
             (!r.reactions.is_empty()).then(|| json!({"k": r.k, "reactions": r.reactions}));
         self.with(|w| {
-            w.proto(
-                &format!("/rod/{name}"),
-                t,
-                &rod_update(t, id, &pts, thickness, c),
-            )?;
+            w.proto(rod_topic, t, &rod_update(t, id, &pts, thickness, c))?;
             if matches!(r.kind, PathKind::Optimal | PathKind::Feasible) {
-                w.proto(&format!("/end_pose/{name}"), t, &end_pose(t, end, frame))?;
+                w.proto(pose_topic, t, &end_pose(t, end, frame))?;
             }
             w.json(
-                &format!("/metrics/{name}"),
+                metrics_topic,
                 "dlo.ShapeMetrics",
                 &metrics_schema(),
                 t,
@@ -237,7 +236,7 @@ impl PlanObserver for PlanLog {
             )?;
             if let (PathKind::Feasible, Some(rj)) = (r.kind, &reactions) {
                 w.json(
-                    "/reactions/feasible",
+                    topics::REACTIONS_FEASIBLE,
                     "dlo.Reactions",
                     &json!({"type": "object"}),
                     t,
@@ -261,14 +260,14 @@ impl PlanObserver for PlanLog {
         });
         self.with(|w| {
             w.json(
-                "/optimiser/progress",
+                topics::OPTIMISER_PROGRESS,
                 "dlo.OptimiserProgress",
                 &json!({"type": "object"}),
                 t,
                 &msg,
             )?;
             w.proto(
-                "/optimiser/worst",
+                topics::OPTIMISER_WORST,
                 t,
                 &rod_update(t, "worst", &pts, thickness, color(0.9, 0.6, 0.1, 1.0)),
             )
@@ -292,17 +291,17 @@ pub fn log_static(
     let thickness = rod_thickness(model.rod.radius, model.rod.length);
     scene_start(&mut w, t0, obstacles, model.rod.length)?;
     w.proto(
-        "/rod/shape",
+        topics::SHAPE,
         t0,
         &rod_update(t0, "shape", &pts, thickness, color(0.1, 0.4, 0.9, 1.0)),
     )?;
     w.proto(
-        "/end_pose/shape",
+        topics::END_POSE_SHAPE,
         t0,
         &end_pose(t0, end, model.frame_at(a, 1.0)),
     )?;
     w.json(
-        "/metrics/shape",
+        topics::METRICS_SHAPE,
         "dlo.ShapeReport",
         &json!({"type": "object"}),
         t0,
@@ -328,7 +327,7 @@ pub fn log_margin(
     scene_start(&mut w, t0, obstacles, model.rod.length)?;
     if !fingers.is_empty() {
         w.proto(
-            "/grasp/fingers",
+            topics::GRASP_FINGERS,
             t0,
             &super::scene::fingers_update(t0, fingers, model.rod.length),
         )?;
@@ -336,7 +335,7 @@ pub fn log_margin(
     for (i, lim) in margin.table.iter().enumerate() {
         let t = t0 + i as u64 * 100_000_000;
         w.proto(
-            "/grasp/held_shape",
+            topics::GRASP_HELD_SHAPE,
             t,
             &rod_update(
                 t,
@@ -347,7 +346,7 @@ pub fn log_margin(
             ),
         )?;
         w.json(
-            "/grasp/limits",
+            topics::GRASP_LIMITS,
             "dlo.GraspLimit",
             &json!({"type": "object"}),
             t,

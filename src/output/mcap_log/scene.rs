@@ -5,7 +5,7 @@
 //! `world → rod` maps the paper's x to Foxglove's z (up), its z to Foxglove's x, and its y to
 //! −y (a proper rotation: 180° about `(x + z)/√2`).
 
-use crate::obstacle::{Obstacle, ObstacleShape};
+use crate::scene::obstacle::{Obstacle, ObstacleShape};
 use foxglove::schemas::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3, Pose,
     PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp,
@@ -375,7 +375,7 @@ fn frame_with_z(z: [f64; 3]) -> [[f64; 3]; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::rotation;
+    use crate::rod::kinematics::rotation;
 
     #[test]
     fn quaternion_round_trips_a_rotation() {

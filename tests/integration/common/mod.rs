@@ -1,14 +1,14 @@
 //! Shared helpers for integration tests: closed-form references and small problem builders.
 #![allow(dead_code)]
 
-use dlo_planner::basis::Basis;
 use dlo_planner::constraints::{
     Angle, Bound, Constraint, OrientationConstraint, PositionConstraint,
 };
-use dlo_planner::layout::{Field, Layout};
-use dlo_planner::model::{Discretisation, Model};
-use dlo_planner::problem::StaticProblem;
+use dlo_planner::rod::basis::Basis;
+use dlo_planner::rod::layout::{Field, Layout};
+use dlo_planner::rod::model::{Discretisation, Model};
 use dlo_planner::rod::{Profile, Rod};
+use dlo_planner::statics::problem::StaticProblem;
 
 /// Complete elliptic integrals `K(m)`, `E(m)` (parameter `m = k²`) by the arithmetic–geometric
 /// mean (Abramowitz & Stegun 17.6).

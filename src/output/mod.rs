@@ -1,0 +1,9 @@
+//! What runs write for people and viewers: MCAP logs for Foxglove (feature `mcap`), with their
+//! topic names in [`topics`], and SVG pictures of those logs (feature `plot`).
+
+#[cfg(feature = "mcap")]
+pub mod mcap_log;
+#[cfg(feature = "plot")]
+pub mod plot;
+#[cfg(feature = "mcap")]
+pub mod topics;

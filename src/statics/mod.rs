@@ -1,0 +1,14 @@
+//! Static shapes (paper §4): the problem (energy and constraints as a nonlinear program), its
+//! solve by the multiplier method, the reactions, the moment balance that checks them, the
+//! stability verdict, and the reports.
+
+pub mod balance;
+pub mod builder;
+pub mod problem;
+pub mod report;
+mod solve;
+pub mod stability;
+
+pub use builder::{BuildError, StaticProblemBuilder};
+pub use problem::StaticProblem;
+pub use solve::*;
