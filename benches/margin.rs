@@ -1,7 +1,7 @@
 //! Speed of the disturbance force margin: a full F_mub–μ curve (9 points × 9 directions × 10
 //! values of μ) on grasp (a) and grasp (b) (figures quoted in the README).
 //!
-//! Run: `cargo bench --bench margin`
+//! Run: `cargo bench --features bench --bench margin`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dlo_planner::case;

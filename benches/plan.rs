@@ -1,7 +1,7 @@
 //! Speed of planning and replay on the paper's planar example and the three 3D cases, and the
 //! cost of the MCAP log (figures quoted in the README).
 //!
-//! Run: `cargo bench --bench plan`
+//! Run: `cargo bench --features bench --bench plan`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dlo_planner::case;
@@ -44,9 +44,9 @@ fn benches(c: &mut Criterion) {
     let r = pl.run(&mut Silent);
     let path = pl.with_terms(r.path_terms).path();
     let opts = ReplayOptions {
-        steps: pl.options.replay_steps,
-        refinements: pl.options.refinements,
-        tolerance: pl.options.tolerance,
+        steps: pl.settings.replay_steps,
+        refinements: pl.settings.replay_refinements,
+        tolerance: pl.settings.coincide_tolerance,
     };
     g.bench_function("replay (41 steps)", |b| {
         b.iter(|| {

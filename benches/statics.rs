@@ -1,6 +1,6 @@
 //! Speed of the rod model and the static solver (figures quoted in the README).
 //!
-//! Run: `cargo bench --bench statics`
+//! Run: `cargo bench --features bench --bench statics`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dlo_planner::case;

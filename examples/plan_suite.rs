@@ -205,7 +205,7 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = &p.base.model;
     let l = model.rod.length;
     let path = p.with_terms(r.path_terms).path();
-    let n = 2 * (p.options.verify_k - 1);
+    let n = 2 * (p.settings.verify_k_samples - 1);
     let mut a = vec![0.0; path.n()];
     let mut shape = Shape::default();
     let mut worst = (f64::INFINITY, 0.0);

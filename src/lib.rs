@@ -4,16 +4,25 @@
 //! threads, thin strips) after Wakamatsu & Hirai, *Static Modeling of Linear Object Deformation
 //! Based on Differential Geometry* (IJRR 2004).
 //!
-//! A shape is four functions of arc length — Euler angles `φ, θ, ψ` and strain `ε` — each a Ritz
-//! combination of `1, s/L, sin(2πis/L), cos(2πis/L)` ([`basis`]). [`model`] precomputes the
-//! discretised rod, [`kinematics`] turns coefficients into positions and frames, [`energy`]
-//! evaluates eq. (7)–(13) with gradients, [`constraints`] holds the geometric constraints of
-//! §3.2, [`optim`] the generic multiplier method and BFGS, and [`statics`] solves static shapes
-//! and reports reaction forces and stability. [`path`] and [`planner`] plan deformation paths
-//! (§7) and replay them by the controlled end. [`case`] reads case files.
+//! A shape is four functions of arc length — Euler angles `φ, θ, ψ` and strain `ε` — each a
+//! Ritz combination of basis functions. The crate is layered:
+//!
+//! - [`rod`]: the material, the basis, the discretised [`rod::Model`], the kinematics that turn
+//!   coefficients into positions and frames, and the energy of eq. (7)–(13) with its
+//!   derivatives;
+//! - [`scene`]: obstacles (parry3d shapes) and triangle meshes;
+//! - [`constraints`]: the constraint kinds of §3.2, one closed enum;
+//! - [`optim`]: the generic multiplier method, BFGS and Newton steps;
+//! - [`statics`]: static shapes — [`statics::StaticProblem::builder`] builds a problem in code,
+//!   [`statics::solve_static`] solves it and reports reactions, moment balance and stability;
+//! - [`planner`]: deformation paths (§7) — [`planner::Planner::new`] takes a
+//!   [`planner::PlanProblem`] and [`planner::PlanSettings`], plans, verifies and replays;
+//! - [`grasp`]: the disturbance force margin of a grasp (§6);
+//! - [`case`]: case files, an adapter from JSON to the types above;
+//! - [`output`]: MCAP logs for Foxglove and SVG plots.
 //!
 //! The library prints nothing. Its default feature `cli` builds the `dlo` tool and with it
-//! `mcap` ([`mcap_log`]: MCAP logs for Foxglove) and `plot` ([`plot`]: SVG pictures of logs); a
+//! `mcap` (MCAP logs for Foxglove, [`output`]) and `plot` (SVG pictures of logs); a
 //! library user who needs neither depends on it with `default-features = false`.
 
 pub mod case;

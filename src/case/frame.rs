@@ -25,10 +25,10 @@
 //! than in the case's axes (where the shipped 3D plans clamp their base on the pole with a free
 //! bending direction), so plans keep the case's axes unless they ask for `"auto"`.
 
+use super::plan::{EndSpec, EulerBranch};
 use super::{CaseFile, ConstraintSpec};
 use crate::constraints::Angle;
 use crate::planner::orientation::{Matrix, nearest};
-use crate::planner::spec::{EndSpec, EulerBranch};
 use crate::rod::kinematics::{angles_of, cross, in_frame, is_rotation, rotation};
 use crate::rod::layout::Field;
 use std::f64::consts::PI;

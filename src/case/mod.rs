@@ -5,6 +5,7 @@
 
 pub mod frame;
 mod limits;
+pub mod plan;
 mod strict_json;
 
 pub use limits::*;

@@ -78,6 +78,17 @@ pub enum AlStatus {
     NumericalFailure,
 }
 
+impl std::fmt::Display for AlStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            AlStatus::Converged => "converged",
+            AlStatus::IterationLimit => "iteration limit reached",
+            AlStatus::Infeasible => "infeasible",
+            AlStatus::NumericalFailure => "numerical failure",
+        })
+    }
+}
+
 /// Result of [`augmented_lagrangian`].
 #[derive(Clone, Debug)]
 pub struct AlOutcome {

@@ -7,6 +7,101 @@ use crate::rod::model::Model;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{StaticOptions, StaticSolution, solve_static};
 
+/// A full orientation of an end, resolved into Euler angles once its reference frame is known
+/// (see [`super::orientation`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndRotation {
+    /// The rotation (row-major, case frame).
+    pub matrix: [[f64; 3]; 3],
+    /// The `φ` the user wrote, if the rotation came from Euler angles (it breaks the tie
+    /// between mirror routes).
+    pub written_phi: Option<f64>,
+}
+
+/// A validated end: pose rows in dimensionless units plus an optional coefficient vector.
+#[derive(Clone, Debug)]
+pub struct End {
+    /// `(component, x/L)` rows.
+    pub position: Vec<(usize, f64)>,
+    /// `(field, angle)` rows (filled from `rotation` when that is given).
+    pub angles: Vec<(crate::rod::layout::Field, f64)>,
+    /// A full orientation whose Euler branch is still to be chosen.
+    pub rotation: Option<EndRotation>,
+    /// Coefficients (the shape, or the solve's start).
+    pub shape: Option<Vec<f64>>,
+}
+
+impl End {
+    /// Whether the end is a pose (to be solved for), not only coefficients.
+    pub fn is_pose(&self) -> bool {
+        !self.position.is_empty() || !self.angles.is_empty() || self.rotation.is_some()
+    }
+
+    /// Fills in the angles of a full orientation, in the branch that continues from
+    /// `reference` (the Euler angles of the frame it continues from; see
+    /// [`super::orientation`]). Errors name the problem (a planar rod's end turned about
+    /// another axis than y).
+    pub fn resolve(
+        &mut self,
+        model: &crate::rod::model::Model,
+        reference: [f64; 3],
+    ) -> Result<(), String> {
+        let planar = !model.layout.spatial;
+        use crate::rod::layout::Field;
+        let Some(r) = self.rotation.take() else {
+            return Ok(());
+        };
+        if planar {
+            let theta = super::orientation::planar_branch(r.matrix, reference[1]).ok_or(
+                "a planar rod's end turns about y only: the orientation is not a rotation about y",
+            )?;
+            self.angles = vec![(Field::Theta, theta)];
+        } else {
+            // In the rod's angles' frame; a written φ is the case's, not the fields'.
+            let written_phi = r.written_phi.filter(|_| model.frame.is_none());
+            let matrix = model.rotation_to_angles(r.matrix);
+            let [phi, theta, psi] =
+                super::orientation::euler_branch(matrix, reference, written_phi);
+            self.angles = vec![(Field::Phi, phi), (Field::Theta, theta), (Field::Psi, psi)];
+        }
+        Ok(())
+    }
+}
+
+impl End {
+    /// The controlled end at `position` (case units) with orientation `rotation` (row-major,
+    /// case axes; on a planar rod a rotation about y), for a rod of `problem`; its Euler branch
+    /// is chosen when the plan is set up.
+    pub fn pose(problem: &StaticProblem, position: [f64; 3], rotation: [[f64; 3]; 3]) -> End {
+        let l = problem.model.rod.length;
+        End {
+            position: problem
+                .model
+                .layout
+                .components()
+                .iter()
+                .map(|&k| (k, position[k] / l))
+                .collect(),
+            angles: Vec::new(),
+            rotation: Some(EndRotation {
+                matrix: rotation,
+                written_phi: None,
+            }),
+            shape: None,
+        }
+    }
+
+    /// The shape of coefficients `a` itself, not solved for.
+    pub fn shape(a: Vec<f64>) -> End {
+        End {
+            position: Vec::new(),
+            angles: Vec::new(),
+            rotation: None,
+            shape: Some(a),
+        }
+    }
+}
+
 /// Pose of `P(L)`: position rows `(component, x/L)` and Euler-angle rows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EndPose {

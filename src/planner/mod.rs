@@ -14,43 +14,106 @@ pub mod path;
 mod refine;
 pub mod replay;
 pub mod result;
-pub mod spec;
+pub mod settings;
 mod starts;
 pub mod swept;
 mod tracking;
 pub mod trajectory;
 pub mod verify;
 
-use crate::case::Case;
 use crate::constraints::{Angle, Constraint};
-use crate::error::Error;
 use crate::optim::AlStatus;
 use crate::planner::path::DeformationPath;
 use crate::rod::kinematics::Shape;
 use crate::scene::obstacle::Obstacle;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
+pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, ShapeRecord};
 use replay::{ReplayOptions, replay};
-use spec::{End, PlanOptions};
+pub use settings::{Optimiser, PlanSettings, SettingsError};
 use std::sync::Arc;
 use verify::fine_model;
 
 use refine::Verified;
-pub use result::{PlanResult, PlanStatus, StartSummary, Timing};
+pub use result::{PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
+
+/// What to plan: the rod held at its base (its static problem: the fixed conditions,
+/// obstacles and self-contact), where its controlled end starts and where it goes.
+#[derive(Clone, Debug)]
+pub struct PlanProblem {
+    /// The static problem without the controlled end's pose.
+    pub statics: StaticProblem,
+    /// The obstacles (also among the static problem's constraints), for logs and plots.
+    pub obstacles: Vec<Arc<Obstacle>>,
+    /// Where the controlled end starts: a pose, or a shape.
+    pub start: End,
+    /// Where it goes.
+    pub goal: End,
+    /// The shape the start and goal solves begin from (e.g.
+    /// [`StaticProblem::natural_start`]).
+    pub initial: Vec<f64>,
+    /// Settings of the static solves (start, goal, replay); their optimality tolerance is
+    /// taken no tighter than 1e-5 and their Newton steps no longer than 0.1.
+    pub static_settings: StaticOptions,
+}
+
+impl PlanProblem {
+    /// A problem from `statics` (the held rod), with its obstacles gathered from its
+    /// constraints, the default static settings and the natural start.
+    pub fn new(statics: StaticProblem, start: End, goal: End) -> PlanProblem {
+        let obstacles = statics
+            .constraints
+            .iter()
+            .filter_map(|c| match c {
+                Constraint::Obstacle(o) => Some(o.obstacle.clone()),
+                _ => None,
+            })
+            .collect();
+        let initial = statics.natural_start(0.1);
+        PlanProblem {
+            statics,
+            obstacles,
+            start,
+            goal,
+            initial,
+            static_settings: StaticOptions::default(),
+        }
+    }
+}
+
+/// Why a plan could not be set up.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanSetupError {
+    /// A setting is out of range.
+    #[error("settings: {0}")]
+    Settings(#[from] SettingsError),
+    /// The problem cannot be planned (e.g. a free base).
+    #[error("{0}")]
+    Problem(String),
+    /// The start or the goal cannot be reached or is ill-posed.
+    #[error("{end}: {message}")]
+    End {
+        /// `start` or `goal`.
+        end: &'static str,
+        /// Why.
+        message: String,
+    },
+}
 
 /// A planning problem ready to run: the held end's conditions, the obstacles, and the two
 /// solved end shapes.
 #[derive(Clone, Debug)]
 pub struct Planner {
-    /// The case's static problem (fixed conditions, obstacles, self-contact).
+    /// The static problem without the controlled end (fixed conditions, obstacles,
+    /// self-contact).
     pub base: StaticProblem,
     /// Obstacles.
     pub obstacles: Vec<Arc<Obstacle>>,
     /// Settings.
-    pub options: PlanOptions,
+    pub settings: PlanSettings,
     /// Static solver settings (endpoints and replay).
     pub static_options: StaticOptions,
     /// The start shape's solve.
@@ -127,16 +190,16 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Constraint>) 
 /// from the held frame `held` (see [`held_frame`]) towards its own, else from the case's
 /// initial shape.
 fn end_shape(
-    case: &Case,
-    field: &str,
+    problem: &PlanProblem,
+    which: &'static str,
     end: &End,
     held: ([f64; 3], bool),
     opts: &StaticOptions,
-) -> Result<StaticSolution, Error> {
+) -> Result<StaticSolution, PlanSetupError> {
     let seed = end_angles(end)
-        .filter(|_| case.problem.model.layout.spatial)
+        .filter(|_| problem.statics.model.layout.spatial)
         .map(|e| (held, e));
-    let base = &case.problem;
+    let base = &problem.statics;
     let pose = EndPose {
         position: end.position.clone(),
         angles: end
@@ -182,9 +245,9 @@ fn end_shape(
         let a0 = match (&end.shape, seed) {
             (Some(a), _) => a.clone(),
             (None, Some(((held, phi_fixed), target))) => {
-                endpoints::seed_towards(&base.model, &case.initial, held, phi_fixed, target)
+                endpoints::seed_towards(&base.model, &problem.initial, held, phi_fixed, target)
             }
-            (None, None) => case.initial.clone(),
+            (None, None) => problem.initial.clone(),
         };
         solve_static(&mut pose.problem(base), &a0, opts)
     };
@@ -194,7 +257,7 @@ fn end_shape(
                 "the given shape violates the case's constraints or obstacles by {:.3e} (units of L)",
                 sol.max_violation
             )
-        } else if let Some(inside) = end_inside_obstacle(case, end) {
+        } else if let Some(inside) = end_inside_obstacle(base, end) {
             inside
         } else {
             let blocking = pose
@@ -208,15 +271,18 @@ fn end_shape(
                 sol.status, sol.max_violation
             )
         };
-        return Err(Error::invalid(&case.path, format!("plan.{field}"), msg));
+        return Err(PlanSetupError::End {
+            end: which,
+            message: msg,
+        });
     }
     Ok(sol)
 }
 
 /// Whether the end's position (when every component is given) lies inside an obstacle or
 /// closer to it than the rod's radius and the obstacle's margin allow; says which.
-fn end_inside_obstacle(case: &Case, end: &End) -> Option<String> {
-    let model = &case.problem.model;
+fn end_inside_obstacle(base: &StaticProblem, end: &End) -> Option<String> {
+    let model = &base.model;
     let l = model.rod.length;
     let comps = if model.layout.spatial { 3 } else { 2 };
     if end.position.len() < comps {
@@ -226,7 +292,7 @@ fn end_inside_obstacle(case: &Case, end: &End) -> Option<String> {
     for &(k, x) in &end.position {
         p[k] = x * l;
     }
-    case.problem.constraints.iter().find_map(|c| {
+    base.constraints.iter().find_map(|c| {
         let Constraint::Obstacle(oc) = c else {
             return None;
         };
@@ -253,13 +319,13 @@ fn end_angles(end: &End) -> Option<[f64; 3]> {
 /// The Euler angles of the held end's frame as the case prescribes it: the orientation
 /// constraints at `s = 0` (a prescribed `φ + ψ` counts as `ψ`), zero where nothing is
 /// prescribed (the natural state's frame); and whether `φ(0)` itself is prescribed.
-fn held_frame(case: &Case) -> ([f64; 3], bool) {
+fn held_frame(base: &StaticProblem) -> ([f64; 3], bool) {
     use crate::constraints::Angle;
     use crate::rod::layout::Field;
     let mut angles = [0.0; 3];
     let mut phi_fixed = false;
     // The rows the problem holds (in the rod's angles' frame, which may not be the case's).
-    for c in &case.problem.constraints {
+    for c in &base.constraints {
         let Constraint::Orientation(oc) = c else {
             continue;
         };
@@ -287,12 +353,40 @@ fn held_frame(case: &Case) -> ([f64; 3], bool) {
 }
 
 impl Planner {
-    /// Validates the case's `plan` section and solves the start and goal shapes.
-    pub fn from_case(case: &Case) -> Result<Planner, Error> {
-        let options = spec::plan_options(case)?;
-        // Replay and endpoint solves: the case's settings, with the optimality tolerance no
+    /// Checks `settings` and solves the start and goal shapes of `problem`.
+    ///
+    /// ```
+    /// use dlo_planner::planner::{End, PlanProblem, PlanSettings, Planner};
+    /// use dlo_planner::planner::observer::Silent;
+    /// use dlo_planner::rod::{Rod, layout::Layout};
+    /// use dlo_planner::statics::StaticProblem;
+    ///
+    /// // The paper's §7.2 strip: clamped at the origin along +z, its end moved from one side
+    /// // to the other with its tangent turned by a right angle either way.
+    /// let rod = Rod::uniform(1.0, 1.0);
+    /// let held = StaticProblem::builder(rod.clone(), Layout::of(&rod, 4))
+    ///     .clamp(0.0, [0.0; 3], &[0.0])
+    ///     .build()
+    ///     .unwrap();
+    /// let about_y = |t: f64| [[t.cos(), 0.0, t.sin()], [0.0, 1.0, 0.0], [-t.sin(), 0.0, t.cos()]];
+    /// let start = End::pose(&held, [0.4, 0.0, 0.6], about_y(std::f64::consts::FRAC_PI_2));
+    /// let goal = End::pose(&held, [-0.4, 0.0, 0.6], about_y(-std::f64::consts::FRAC_PI_2));
+    /// let settings = PlanSettings { verify_k_samples: 51, ..PlanSettings::default() };
+    /// let planner = Planner::new(PlanProblem::new(held, start, goal), settings).unwrap();
+    /// let plan = planner.run(&mut Silent);
+    /// assert!(plan.u_max <= plan.u_max_straight * (1.0 + 1e-9));
+    /// ```
+    pub fn new(problem: PlanProblem, settings: PlanSettings) -> Result<Planner, PlanSetupError> {
+        let model = &problem.statics.model;
+        settings.validate(model.rod.length)?;
+        if model.layout.free_base {
+            return Err(PlanSetupError::Problem(
+                "planning holds the base fixed (the held end); a free base is not supported".into(),
+            ));
+        }
+        // Replay and endpoint solves: the problem's settings, with the optimality tolerance no
         // tighter than 1e-5 (replayed shapes are compared at the 1e-3 L level).
-        let mut static_options = case.options;
+        let mut static_options = problem.static_settings;
         static_options.al.optimality_tol = static_options.al.optimality_tol.max(1e-5);
         // Newton steps of at most 0.1 per coefficient: replay and tracking solves continue from
         // the previous shape and must stay on its branch of equilibria (unlimited steps let a
@@ -300,27 +394,35 @@ impl Planner {
         static_options.al.max_step = static_options.al.max_step.min(0.1);
         // Full orientations take the Euler branch that continues from the held end's frame
         // (start) and from the start shape's end (goal).
-        let model = &case.problem.model;
-        let resolve = |end: &mut End, field: &str, reference: [f64; 3]| {
+        let resolve = |end: &mut End, which: &'static str, reference: [f64; 3]| {
             end.resolve(model, reference)
-                .map_err(|m| Error::invalid(&case.path, format!("plan.{field}"), m))
+                .map_err(|message| PlanSetupError::End {
+                    end: which,
+                    message,
+                })
         };
-        let mut options = options;
-        let held = held_frame(case);
-        resolve(&mut options.start, "start", held.0)?;
-        let start = end_shape(case, "start", &options.start, held, &static_options)?;
-        resolve(&mut options.goal, "goal", model.angles_at(&start.a, 1.0))?;
-        let goal = end_shape(case, "goal", &options.goal, held, &static_options)?;
-        let (linear_rows, _) = classify(&case.problem, 0.0);
+        let (mut start_end, mut goal_end) = (problem.start.clone(), problem.goal.clone());
+        let held = held_frame(&problem.statics);
+        resolve(&mut start_end, "start", held.0)?;
+        let start = end_shape(&problem, "start", &start_end, held, &static_options)?;
+        resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
+        let goal = end_shape(&problem, "goal", &goal_end, held, &static_options)?;
+        let (linear_rows, _) = classify(&problem.statics, 0.0);
         Ok(Planner {
-            base: case.problem.clone(),
-            obstacles: case.obstacles.clone(),
-            options,
+            base: problem.statics,
+            obstacles: problem.obstacles,
+            settings,
             static_options,
             start,
             goal,
             linear_rows,
         })
+    }
+
+    /// The optimiser's extra clearance from obstacles in units of `L` (see
+    /// [`PlanSettings::safety`]).
+    pub fn safety(&self) -> f64 {
+        self.settings.safety(self.base.model.rod.length)
     }
 
     /// Depth below which a verified clearance counts as a collision (1e-6 L).
@@ -341,20 +443,20 @@ impl Planner {
         DeformationPath::new(
             self.start.a.clone(),
             self.goal.a.clone(),
-            self.options.terms,
+            self.settings.path_terms,
             &self.linear_rows,
         )
     }
 
     /// The optimiser's problem with `blocks` from the case and the safety margin.
     pub fn minimax_problem(&self) -> MinimaxProblem {
-        let nk = self.options.k_samples;
+        let nk = self.settings.k_samples;
         self.minimax_problem_at((0..nk).map(|j| j as f64 / (nk - 1) as f64).collect())
     }
 
     /// The optimiser's problem on the samples `ks` (increasing, from 0 to 1).
     pub fn minimax_problem_at(&self, ks: Vec<f64>) -> MinimaxProblem {
-        let (_, blocks) = classify(&self.base, self.options.safety);
+        let (_, blocks) = classify(&self.base, self.safety());
         let mut p = MinimaxProblem::new(
             self.base.model.clone(),
             self.path(),
@@ -362,8 +464,8 @@ impl Planner {
             blocks,
             self.base.objective,
         );
-        p.mean_weight = self.options.mean_weight;
-        p.set_swept(self.options.swept);
+        p.mean_weight = self.settings.mean_weight;
+        p.set_swept(self.settings.swept_clearance);
         p.set_skip_clear_samples(true);
         p
     }
@@ -394,12 +496,12 @@ impl Planner {
         let t0 = std::time::Instant::now();
         let path = self.path();
         let nv = path.n_vars();
-        let fine = fine_model(model, self.options.verify_s, 4);
+        let fine = fine_model(model, self.settings.verify_s_samples, 4);
         let straight = self.verify_on(&fine, &path, &vec![0.0; nv]);
         {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();
-            let steps = self.options.replay_steps;
+            let steps = self.settings.replay_steps;
             for i in 0..=steps {
                 let k = i as f64 / steps as f64;
                 path.shape_at(&vec![0.0; nv], k, &mut a);
@@ -459,9 +561,9 @@ impl Planner {
             &path,
             &chosen.z,
             ReplayOptions {
-                steps: self.options.replay_steps,
-                refinements: self.options.refinements,
-                tolerance: self.options.tolerance,
+                steps: self.settings.replay_steps,
+                refinements: self.settings.replay_refinements,
+                tolerance: self.settings.coincide_tolerance,
             },
             &self.static_options,
             observer,
@@ -505,10 +607,10 @@ impl Planner {
                     }
                 })
                 .collect(),
-            starts_not_run: self.options.starts
+            starts_not_run: self.settings.starts
                 - runs
                     .iter()
-                    .filter(|r| r.index < self.options.starts)
+                    .filter(|r| r.index < self.settings.starts)
                     .count(),
             path_terms,
             chosen_start: runs[best].index,

@@ -4,7 +4,7 @@
 use super::observer::{PlanObserver, Progress};
 use super::refine::Verified;
 use super::verify::Verification;
-use super::{Planner, spec};
+use super::{Planner, settings};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
 
 /// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
@@ -66,7 +66,7 @@ impl Planner {
             max_outer: 30,
             max_inner: 300,
             active_tol: 1e-7,
-            second_order: self.options.optimiser == spec::Optimiser::Newton,
+            second_order: self.settings.optimiser == settings::Optimiser::Newton,
             max_step: f64::INFINITY,
             newton_multipliers: false,
         }
@@ -102,7 +102,7 @@ impl Planner {
         };
         let al = self.stage_options();
         let mut z = z0;
-        for (stage, &b) in self.options.sharpness.iter().enumerate().skip(first_stage) {
+        for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
             let out = {
                 let sink = &mut *sink;

@@ -32,8 +32,8 @@ impl Planner {
         sink: &mut dyn FnMut(Progress, Vec<f64>),
     ) -> Verified {
         let tol = self.collision_tolerance();
-        let h = 1.0 / (self.options.verify_k - 1) as f64;
-        let gap = self.options.energy_gap;
+        let h = 1.0 / (self.settings.verify_k_samples - 1) as f64;
+        let gap = self.settings.energy_gap_tolerance;
         let missed_peak = |r: &StartRun, v: &Verification| {
             v.u_max - r.sampled_max > gap * r.sampled_max.abs().max(v.u_max.abs())
         };
@@ -45,7 +45,7 @@ impl Planner {
         let mut ks = uniform.to_vec();
         let mut added = Vec::new();
         let mut kept: Option<(StartRun, Verification)> = None;
-        for _ in 0..self.options.sample_refinements {
+        for _ in 0..self.settings.sample_refinements {
             let tunnels = !ver.collision_free(tol);
             let peak = missed_peak(&chosen, &ver);
             if !tunnels && !peak {
@@ -84,7 +84,7 @@ impl Planner {
                 kept = Some((chosen.clone(), ver.clone()));
             }
             // Warm: only the sharpest stage again.
-            let last = self.options.sharpness.len() - 1;
+            let last = self.settings.sharpness.len() - 1;
             let r = self.optimise_from(start, chosen.z.clone(), &ks, last, sink);
             chosen = StartRun {
                 evaluations: chosen.evaluations + r.evaluations,

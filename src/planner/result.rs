@@ -18,6 +18,59 @@ pub enum PlanStatus {
     NotConverged,
 }
 
+impl std::fmt::Display for PlanStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            PlanStatus::Planned => "planned",
+            PlanStatus::Collision => "collision",
+            PlanStatus::NotConverged => "not converged",
+        })
+    }
+}
+
+/// What a plan run means for a robot: whether moving the controlled end along the plan's
+/// trajectory deforms the rod as planned, and if not, why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanVerdict {
+    /// Converged, collision-free on the verification grid, and the replay by the controlled
+    /// end coincides with the plan: the gripper trajectory executes it.
+    Executable,
+    /// Converged and collision-free, but the replay departs from the plan by more than the
+    /// coincidence tolerance without snapping.
+    Departs,
+    /// Converged and collision-free, but the replay snaps through (jumps to another
+    /// equilibrium) somewhere along the path.
+    SnapsThrough,
+    /// The verification grid finds the rod inside (or closer than its radius and margin to)
+    /// an obstacle.
+    ObstacleCollision,
+    /// The verification grid finds the rod crossing itself.
+    SelfCollision,
+    /// The path optimiser did not converge.
+    NotConverged,
+}
+
+impl PlanVerdict {
+    /// Whether the controlled end's trajectory executes the plan.
+    pub fn is_executable(self) -> bool {
+        self == PlanVerdict::Executable
+    }
+}
+
+impl std::fmt::Display for PlanVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            PlanVerdict::Executable => "executable",
+            PlanVerdict::Departs => "not executable: the replay departs from the plan",
+            PlanVerdict::SnapsThrough => "not executable: the replay snaps through",
+            PlanVerdict::ObstacleCollision => "collision with an obstacle",
+            PlanVerdict::SelfCollision => "the rod crosses itself",
+            PlanVerdict::NotConverged => "the path optimiser did not converge",
+        })
+    }
+}
+
 /// Summary of one optimiser start.
 #[derive(Clone, Debug, Serialize)]
 pub struct StartSummary {
@@ -98,6 +151,22 @@ pub struct PlanResult {
     pub added_samples: Vec<f64>,
     /// Seconds spent planning (optimise + verify) and replaying.
     pub timing_s: Timing,
+}
+
+impl PlanResult {
+    /// The verdict: executable, or why not.
+    pub fn verdict(&self) -> PlanVerdict {
+        match self.status {
+            PlanStatus::Collision if self.min_clearance.is_none_or(|c| c >= 0.0) => {
+                PlanVerdict::SelfCollision
+            }
+            PlanStatus::Collision => PlanVerdict::ObstacleCollision,
+            PlanStatus::NotConverged => PlanVerdict::NotConverged,
+            PlanStatus::Planned if self.replay.coincide => PlanVerdict::Executable,
+            PlanStatus::Planned if !self.replay.snaps.is_empty() => PlanVerdict::SnapsThrough,
+            PlanStatus::Planned => PlanVerdict::Departs,
+        }
+    }
 }
 
 /// Wall-clock times.

@@ -29,7 +29,7 @@ impl Planner {
     /// [`Planner::path`] is the path of a plan whose `path_terms` is `terms`.
     pub fn with_terms(&self, terms: usize) -> Planner {
         let mut p = self.clone();
-        p.options.terms = terms;
+        p.settings.path_terms = terms;
         p
     }
 
@@ -44,7 +44,7 @@ impl Planner {
             fine,
             path,
             z,
-            self.options.verify_k,
+            self.settings.verify_k_samples,
             &self.obstacles,
             self.base.objective,
             self.has_self_contact(),
@@ -60,7 +60,7 @@ impl Planner {
             r.run.violation <= 1e-6,
             r.run
                 .equilibrium_deviation
-                .is_some_and(|d| d <= self.options.tolerance),
+                .is_some_and(|d| d <= self.settings.coincide_tolerance),
         )
     }
 
@@ -71,12 +71,12 @@ impl Planner {
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> Vec<StartPlan> {
-        let nk = self.options.k_samples;
+        let nk = self.settings.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
-        let starts = self.options.starts;
+        let starts = self.settings.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
         // The case's planner, then one per fallback count, made only when it is reached.
-        let fallbacks = self.options.fallback_terms.iter();
+        let fallbacks = self.settings.fallback_path_terms.iter();
         let attempts = std::iter::once(Cow::Borrowed(self))
             .chain(fallbacks.map(|&t| Cow::Owned(self.with_terms(t))));
         'attempts: for (attempt, pl) in attempts.enumerate() {
@@ -87,19 +87,23 @@ impl Planner {
             // for the first, `start_spread` for the others.
             let zs: Vec<(usize, Vec<f64>)> = (0..starts)
                 .map(|s| {
-                    let amp = if s == 0 { 1e-2 } else { self.options.spread };
-                    let z0 = noise(self.options.seed.wrapping_add(s as u64), nv)
+                    let amp = if s == 0 {
+                        1e-2
+                    } else {
+                        self.settings.start_spread
+                    };
+                    let z0 = noise(self.settings.seed.wrapping_add(s as u64), nv)
                         .into_iter()
                         .map(|v| amp * v)
                         .collect();
                     (attempt * starts + s, z0)
                 })
                 .collect();
-            for group in zs.chunks(self.options.parallel_starts) {
+            for group in zs.chunks(self.settings.parallel_starts()) {
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
-                    terms: pl.options.terms,
+                    terms: pl.settings.path_terms,
                     plan,
                 }));
                 // Checked before the next group, and before the next fallback planner is made.

@@ -25,25 +25,25 @@ impl Planner {
         tally: &mut Tally,
         al: AlOptions,
     ) -> (usize, usize, Option<f64>) {
-        if self.options.track_weight <= 0.0 {
+        if self.settings.equilibrium_weight <= 0.0 {
             return (0, 0, None);
         }
         let mut estimate = None;
         let mut failed = false;
         let mut tracking_rounds = 0;
         let mut kept = 0;
-        p.track_weight = self.options.track_weight;
+        p.track_weight = self.settings.equilibrium_weight;
         // Targets keep the optimiser's safety margin from obstacles.
         let mut inflated = self.base.clone();
         for con in inflated.constraints.iter_mut() {
             if let Constraint::Obstacle(ob) = con {
-                ob.clearance += self.options.safety;
+                ob.clearance += self.safety();
             }
         }
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of
         // the coincidence tolerance from their equilibria, or when a round brought them less
         // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
-        let done = self.options.track_stop * self.options.tolerance;
+        let done = self.settings.equilibrium_stop * self.settings.coincide_tolerance;
         let mut dev_prev = f64::INFINITY;
         // The path before the last round, with its tally: a round that leaves the samples
         // farther from their equilibria is undone.
@@ -59,7 +59,7 @@ impl Planner {
                 &self.static_options,
             )
         };
-        for _ in 0..self.options.track_rounds {
+        for _ in 0..self.settings.equilibrium_rounds {
             let targets = equilibria(p, z);
             let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
                 old.iter()

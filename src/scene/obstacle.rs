@@ -31,6 +31,23 @@ pub enum ObstacleShape {
     HalfSpace([f64; 3]),
 }
 
+impl ObstacleShape {
+    /// A sphere of `radius`.
+    pub fn ball(radius: f64) -> ObstacleShape {
+        ObstacleShape::Ball(Ball::new(radius))
+    }
+
+    /// A box with `half_extents` along its local x, y, z.
+    pub fn cuboid(half_extents: [f64; 3]) -> ObstacleShape {
+        ObstacleShape::Cuboid(Cuboid::new(half_extents.into()))
+    }
+
+    /// A cylinder of `radius` whose axis runs along its local y, `half_height` either way.
+    pub fn cylinder(half_height: f64, radius: f64) -> ObstacleShape {
+        ObstacleShape::Cylinder(Cylinder::new(half_height, radius))
+    }
+}
+
 impl std::fmt::Debug for ObstacleShape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let name = match self {

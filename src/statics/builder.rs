@@ -182,7 +182,8 @@ impl StaticProblemBuilder {
     }
 
     /// Clamps the rod at `s`: the point at `p` and the angles `angles` — `[θ]` on a planar
-    /// rod, `[φ, θ, ψ]` on a 3D one.
+    /// rod, `[φ, θ, ψ]` on a 3D one. At `s = 0` of a fixed base the point is the base
+    /// position.
     pub fn clamp(self, s: f64, p: [f64; 3], angles: &[f64]) -> Self {
         let fields: &[Field] = if self.layout.spatial {
             &[Field::Phi, Field::Theta, Field::Psi]
@@ -194,7 +195,11 @@ impl StaticProblemBuilder {
             .zip(angles)
             .map(|(&f, &v)| (Angle::Field(f), v))
             .collect();
-        let mut b = self.fix_point(s, p);
+        let mut b = if s == 0.0 && !self.layout.free_base {
+            self.base(p)
+        } else {
+            self.fix_point(s, p)
+        };
         if angles.len() != fields.len() {
             b.items.push(Item::Invalid(format!(
                 "a clamp of a {} rod takes {} angles, got {}",

@@ -33,6 +33,16 @@ pub enum Verdict {
     Marginal,
 }
 
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Verdict::Stable => "stable",
+            Verdict::Unstable => "unstable",
+            Verdict::Marginal => "marginal (undecided)",
+        })
+    }
+}
+
 /// The verdict with its numbers.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Stability {

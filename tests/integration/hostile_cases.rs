@@ -155,7 +155,7 @@ fn check(text: &str, path: &Path) -> Result<(), TestCaseError> {
         Ok(c) => {
             VALID.fetch_add(1, Relaxed);
             if c.plan.is_some()
-                && let Err(e) = dlo_planner::planner::spec::plan_options(&c)
+                && let Err(e) = dlo_planner::case::plan::plan_section(&c)
             {
                 named(&e)?;
             }

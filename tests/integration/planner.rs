@@ -276,7 +276,7 @@ fn paper_replay_coincides_from_other_starts() {
 #[test]
 fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let (p, r) = paper();
-    assert_eq!(p.options.parallel_starts, 1);
+    assert_eq!(p.settings.parallel_starts(), 1);
     assert_eq!(
         (r.starts.len(), r.starts_not_run, r.chosen_start),
         (1, 1, 0)
@@ -284,7 +284,7 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let est = r.starts[0]
         .equilibrium_deviation
         .expect("tracking measured it");
-    assert!(est <= p.options.tolerance, "{est}");
+    assert!(est <= p.settings.coincide_tolerance, "{est}");
     assert!(
         (est - r.replay.max_deviation_over_l).abs() < 1e-6,
         "estimate {est}, replay {}",
@@ -313,11 +313,11 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
 #[test]
 fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
     let (p, r) = paper();
-    assert_eq!(p.options.track_stop, 0.8);
+    assert_eq!(p.settings.equilibrium_stop, 0.8);
     let s = &r.starts[0];
     assert_eq!((s.tracking_rounds, s.tracking_rounds_kept), (0, 0));
     let est = s.equilibrium_deviation.expect("measured");
-    assert!(est <= 0.8 * p.options.tolerance, "{est}");
+    assert!(est <= 0.8 * p.settings.coincide_tolerance, "{est}");
     let tenth = paper_with(serde_json::json!({ "equilibrium_stop": 0.1 }));
     let t = &tenth.starts[0];
     assert_eq!((t.tracking_rounds, t.tracking_rounds_kept), (1, 0));
@@ -606,7 +606,8 @@ fn replay_reports_snap_through() {
     assert!(!r.replay.snaps.is_empty());
     assert!(!r.replay.coincide);
     let model = &p.base.model;
-    let finest = 1.0 / (p.options.replay_steps as f64 * 2f64.powi(p.options.refinements as i32));
+    let finest =
+        1.0 / (p.settings.replay_steps as f64 * 2f64.powi(p.settings.replay_refinements as i32));
     for &k in &r.replay.snaps {
         let i = r.replay.steps.iter().position(|s| s.k == k).unwrap();
         let (before, after) = (&r.replay.steps[i - 1], &r.replay.steps[i]);
@@ -1003,7 +1004,7 @@ fn pillar_case_3d_coincides() {
     // single round gives, bit for bit.
     assert_eq!(r.starts[0].tracking_rounds, 2);
     assert_eq!(r.starts[0].tracking_rounds_kept, 1);
-    assert!(r.starts[0].tracking_rounds < p.options.track_rounds);
+    assert!(r.starts[0].tracking_rounds < p.settings.equilibrium_rounds);
     let c = shipped_variant(name, |v| v["plan"]["equilibrium_rounds"] = 1.into());
     let one = Planner::from_case(&c).unwrap().run(&mut Silent);
     assert_eq!(one.starts[0].tracking_rounds, 1);
@@ -1099,7 +1100,7 @@ fn bar_plan_beats_hand_made_paths_with_its_margin() {
     let fine = fine_model(&p.base.model, 256, 4);
     let n = p.start.a.len();
     let path = DeformationPath::new(p.start.a.clone(), p.goal.a.clone(), 1, &[]);
-    let margin = p.options.safety * p.base.model.rod.length;
+    let margin = p.safety() * p.base.model.rod.length;
     let mut best = f64::INFINITY;
     let mut kept = 0;
     for i in 0..=40 {

@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
 use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
-use dlo_planner::planner::{PlanStatus, Planner};
+use dlo_planner::planner::{PlanVerdict, Planner};
 use dlo_planner::statics::report::{ShapeReport, coefficients_json, pose};
 use dlo_planner::statics::{evaluate_shape, solve_static};
 use std::io::IsTerminal;
@@ -570,6 +570,7 @@ impl PlanObserver for CliObserver {
 #[derive(serde::Serialize)]
 struct PlanReport<'a> {
     case: &'a str,
+    verdict: dlo_planner::planner::PlanVerdict,
     #[serde(flatten)]
     result: &'a dlo_planner::planner::PlanResult,
     start_energy: f64,
@@ -660,6 +661,7 @@ fn run_plan(
     }
     let report = PlanReport {
         case: &c.name,
+        verdict: result.verdict(),
         result: &result,
         start_energy: planner.start.energy.internal(),
         goal_energy: planner.goal.energy.internal(),
@@ -681,8 +683,8 @@ fn run_plan(
             return ExitCode::from(EXIT_OUTPUT);
         }
     }
-    match (result.status, result.replay.coincide) {
-        (PlanStatus::Collision, _) if result.min_clearance.is_none_or(|c| c >= 0.0) => {
+    match result.verdict() {
+        PlanVerdict::SelfCollision => {
             let (gap, k) = result.verification.self_contact.unwrap_or((0.0, 0.0));
             eprintln!(
                 "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}); {}",
@@ -691,7 +693,7 @@ fn run_plan(
             );
             ExitCode::from(EXIT_COLLISION)
         }
-        (PlanStatus::Collision, _) => {
+        PlanVerdict::ObstacleCollision => {
             eprintln!(
                 "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}); {}",
                 path.display(),
@@ -718,7 +720,7 @@ fn run_plan(
             );
             ExitCode::from(EXIT_COLLISION)
         }
-        (PlanStatus::NotConverged, _) => {
+        PlanVerdict::NotConverged => {
             eprintln!(
                 "error: {}: the path optimiser did not converge ({:?}, violation {:.2e})",
                 path.display(),
@@ -727,7 +729,7 @@ fn run_plan(
             );
             ExitCode::from(EXIT_NOT_CONVERGED)
         }
-        (PlanStatus::Planned, false) => {
+        PlanVerdict::Departs | PlanVerdict::SnapsThrough => {
             eprintln!(
                 "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}; {}",
                 path.display(),
@@ -743,7 +745,7 @@ fn run_plan(
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
         }
-        (PlanStatus::Planned, true) => ExitCode::SUCCESS,
+        PlanVerdict::Executable => ExitCode::SUCCESS,
     }
 }
 
@@ -759,8 +761,8 @@ fn plan_summary(r: &PlanReport) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "case {}: {:?} (optimiser {:?})",
-        r.case, p.status, p.optimiser
+        "case {}: {} ({}; optimiser {})",
+        r.case, r.verdict, p.status, p.optimiser
     );
     let _ = writeln!(
         o,

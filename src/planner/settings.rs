@@ -1,0 +1,310 @@
+//! The settings of a plan: one struct, with the case file's names (the `plan` section's keys
+//! other than `start` and `goal`), defaults and validation. [`super::Planner::new`] takes it.
+
+use serde::{Deserialize, Serialize};
+
+/// How a plan is computed: the path's form, the optimiser's samples and continuation, the
+/// starts, the verification grid and the replay. Every field is a key of a case file's `plan`
+/// section (`docs/case-files.md` documents them); [`Default`] gives the defaults a case file
+/// gets.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlanSettings {
+    /// Path terms `m` (paper: 3).
+    pub path_terms: usize,
+    /// Path-term counts tried in turn, with the same starts, while no plan so far is estimated
+    /// to coincide with its replay (default: none).
+    pub fallback_path_terms: Vec<usize>,
+    /// Samples of `k` seen by the optimiser, including 0 and 1.
+    pub k_samples: usize,
+    /// Samples of `k` on the verification grid.
+    pub verify_k_samples: usize,
+    /// Intervals of `s` on the verification grid.
+    pub verify_s_samples: usize,
+    /// Extra clearance (case length units) the optimiser keeps from obstacles, so that the path
+    /// between its samples stays clear. Default `L/100`.
+    pub safety_margin: Option<f64>,
+    /// Weight of the mean energy along the path in the objective (see the README).
+    pub mean_weight: f64,
+    /// Weight of the equilibrium-tracking term (0 = the paper's objective alone).
+    pub equilibrium_weight: f64,
+    /// Most rounds of equilibrium tracking (replay at the samples, then re-optimise).
+    pub equilibrium_rounds: usize,
+    /// Tracking stops once the sampled shapes lie within this fraction of
+    /// `coincide_tolerance` from their equilibria (0: only the rounds' budget and their
+    /// progress stop it).
+    pub equilibrium_stop: f64,
+    /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
+    pub sharpness: Vec<f64>,
+    /// Independent optimiser starts (run in parallel, each verified and refined on its own; the
+    /// collision-free one with the lowest verified `U_max` wins).
+    pub starts: usize,
+    /// Starts run side by side in groups of this many; a group runs only when no plan of an
+    /// earlier group is estimated to coincide with its replay (default: all starts at once).
+    pub parallel_starts: Option<usize>,
+    /// Seed of the starts' pseudo-random perturbations.
+    pub seed: u64,
+    /// Size (radians) of the extra starts' perturbations.
+    pub start_spread: f64,
+    /// Rounds of adding samples where the verification grid finds tunnelling or an energy peak
+    /// the samples missed.
+    pub sample_refinements: usize,
+    /// Relative excess of the verification grid's `U_max` over the optimiser's sampled maximum
+    /// beyond which the peak's `k` is added to the samples.
+    pub energy_gap_tolerance: f64,
+    /// Replay steps in `k` (refined where the replayed shape jumps).
+    pub replay_steps: usize,
+    /// Largest number of bisections of one replay step.
+    pub replay_refinements: usize,
+    /// The paths coincide when `max_k d(k) ≤ tolerance · L`.
+    pub coincide_tolerance: f64,
+    /// Inner minimiser of the path optimisation's multiplier method.
+    pub optimiser: Optimiser,
+    /// Keep the chord between consecutive samples' positions of every obstacle sample point
+    /// clear (see [`super::swept`]).
+    pub swept_clearance: bool,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            path_terms: d_terms(),
+            fallback_path_terms: Vec::new(),
+            k_samples: d_k(),
+            verify_k_samples: d_vk(),
+            verify_s_samples: d_vs(),
+            safety_margin: None,
+            mean_weight: d_mean(),
+            equilibrium_weight: d_track(),
+            equilibrium_rounds: d_rounds(),
+            equilibrium_stop: d_track_stop(),
+            sharpness: d_sharp(),
+            starts: d_starts(),
+            parallel_starts: None,
+            seed: d_seed(),
+            start_spread: d_spread(),
+            sample_refinements: d_sample_ref(),
+            energy_gap_tolerance: d_energy_gap(),
+            replay_steps: d_steps(),
+            replay_refinements: d_refine(),
+            coincide_tolerance: d_tol(),
+            optimiser: Optimiser::Bfgs,
+            swept_clearance: d_swept(),
+        }
+    }
+}
+
+/// A setting out of its range: the field (a key of [`PlanSettings`]) and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct SettingsError {
+    /// The field, e.g. `path_terms` or `sharpness[2]`.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
+    SettingsError {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+impl PlanSettings {
+    /// Checks every setting for a rod of `length` (the safety margin is bounded by it).
+    pub fn validate(&self, length: f64) -> Result<(), SettingsError> {
+        let finite = |field: &str, x: f64| {
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(bad(field, format!("must be finite, got {x}")))
+            }
+        };
+        let positive = |field: &str, x: f64| {
+            if !x.is_finite() {
+                Err(bad(field, format!("must be finite, got {x}")))
+            } else if x > 0.0 {
+                Ok(x)
+            } else {
+                Err(bad(field, format!("must be positive, got {x}")))
+            }
+        };
+        let l = length;
+        let (terms_lo, terms_hi) = PATH_TERMS;
+        for (field, val, lo, hi) in [
+            ("path_terms", self.path_terms, terms_lo, terms_hi),
+            ("k_samples", self.k_samples, 3, 2001),
+            ("verify_k_samples", self.verify_k_samples, 3, 100_001),
+            ("verify_s_samples", self.verify_s_samples, 2, 10_000),
+            ("starts", self.starts, 1, 64),
+            ("replay_steps", self.replay_steps, 1, 100_000),
+            ("replay_refinements", self.replay_refinements, 0, 20),
+            ("sample_refinements", self.sample_refinements, 0, 20),
+        ] {
+            if !(lo..=hi).contains(&val) {
+                return Err(bad(field, format!("must be in {lo}..={hi}, got {val}")));
+            }
+        }
+        for (i, &t) in self.fallback_path_terms.iter().enumerate() {
+            if !(terms_lo..=terms_hi).contains(&t) {
+                return Err(bad(
+                    format!("fallback_path_terms[{i}]"),
+                    format!("must be in {terms_lo}..={terms_hi}, got {t}"),
+                ));
+            }
+        }
+        let parallel_starts = self.parallel_starts();
+        if !(1..=self.starts).contains(&parallel_starts) {
+            return Err(bad(
+                "parallel_starts",
+                format!(
+                    "must be in 1..=plan.starts ({}), got {parallel_starts}",
+                    self.starts
+                ),
+            ));
+        }
+        // Grid points of one verification pass.
+        let grid = self.verify_k_samples.saturating_mul(self.verify_s_samples);
+        if grid > 10_000_000 {
+            return Err(bad(
+                "verify_k_samples",
+                format!("verify_k_samples × verify_s_samples = {grid}; at most 1e7"),
+            ));
+        }
+        if self.sharpness.len() > 50 || self.fallback_path_terms.len() > 8 {
+            return Err(bad(
+                if self.sharpness.len() > 50 {
+                    "sharpness"
+                } else {
+                    "fallback_path_terms"
+                },
+                "at most 50 sharpness stages and 8 fallback path-term counts",
+            ));
+        }
+        let safety = self.safety_margin.unwrap_or(l / 100.0);
+        if !(0.0..=0.25 * l).contains(&finite("safety_margin", safety)?) {
+            return Err(bad(
+                "safety_margin",
+                format!("must be in [0, L/4] = [0, {}], got {safety}", 0.25 * l),
+            ));
+        }
+        if finite("mean_weight", self.mean_weight)? < 0.0 {
+            return Err(bad("mean_weight", "must be non-negative"));
+        }
+        if finite("equilibrium_weight", self.equilibrium_weight)? < 0.0 {
+            return Err(bad("equilibrium_weight", "must be non-negative"));
+        }
+        if self.equilibrium_rounds > 50 {
+            return Err(bad("equilibrium_rounds", "must be at most 50"));
+        }
+        let stop = finite("equilibrium_stop", self.equilibrium_stop)?;
+        if !(0.0..1.0).contains(&stop) {
+            return Err(bad(
+                "equilibrium_stop",
+                format!("must be in [0, 1) (a fraction of coincide_tolerance), got {stop}"),
+            ));
+        }
+        if self.sharpness.is_empty() {
+            return Err(bad("sharpness", "needs at least one value"));
+        }
+        for (i, b) in self.sharpness.iter().enumerate() {
+            positive(&format!("sharpness[{i}]"), *b)?;
+        }
+        finite("start_spread", self.start_spread)?;
+        if finite("energy_gap_tolerance", self.energy_gap_tolerance)? < 0.0 {
+            return Err(bad("energy_gap_tolerance", "must be non-negative"));
+        }
+        positive("coincide_tolerance", self.coincide_tolerance)?;
+        Ok(())
+    }
+
+    /// The optimiser's extra clearance from obstacles in units of `L`: `safety_margin`, or
+    /// `L/100` when it is not set.
+    pub fn safety(&self, length: f64) -> f64 {
+        self.safety_margin.unwrap_or(length / 100.0) / length
+    }
+
+    /// Starts run side by side: `parallel_starts`, or all of them.
+    pub fn parallel_starts(&self) -> usize {
+        self.parallel_starts.unwrap_or(self.starts)
+    }
+}
+
+/// Inner minimiser of the path optimisation's sharpness stages (see the README for what each
+/// finds); the equilibrium-tracking rounds always take Newton steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Optimiser {
+    /// BFGS on the augmented function (the default).
+    #[default]
+    Bfgs,
+    /// Damped Newton with the analytic Hessian: it settles in other local minima, whose shapes
+    /// lie farther from the equilibria.
+    Newton,
+}
+
+/// The path-term counts accepted (`plan.path_terms` and each of `plan.fallback_path_terms`).
+const PATH_TERMS: (usize, usize) = (1, 12);
+
+fn d_swept() -> bool {
+    false
+}
+
+fn d_terms() -> usize {
+    3
+}
+fn d_k() -> usize {
+    41
+}
+fn d_vk() -> usize {
+    201
+}
+fn d_vs() -> usize {
+    256
+}
+fn d_mean() -> f64 {
+    1.0
+}
+fn d_track() -> f64 {
+    // With 1000 and three rounds, 7 of 24 random planar start–goal pairs coincided; with this
+    // and eight, 14 (every one of the 7 among them; see the README).
+    10_000.0
+}
+fn d_rounds() -> usize {
+    8
+}
+fn d_track_stop() -> f64 {
+    0.1
+}
+fn d_sharp() -> Vec<f64> {
+    // Two decades in the R5 preferred-number steps (×≈1.6 per stage): a continuation this fine
+    // reaches the paper's coinciding plan from 29 of 32 starts, [10, 100, 1000] from 3 of 16.
+    vec![
+        10.0, 16.0, 25.0, 40.0, 63.0, 100.0, 160.0, 250.0, 400.0, 630.0, 1000.0,
+    ]
+}
+fn d_starts() -> usize {
+    1
+}
+fn d_seed() -> u64 {
+    1
+}
+fn d_spread() -> f64 {
+    0.5
+}
+fn d_sample_ref() -> usize {
+    4
+}
+fn d_energy_gap() -> f64 {
+    0.01
+}
+fn d_steps() -> usize {
+    40
+}
+fn d_refine() -> usize {
+    4
+}
+fn d_tol() -> f64 {
+    0.02
+}
