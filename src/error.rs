@@ -48,3 +48,14 @@ impl Error {
         }
     }
 }
+
+/// A setting out of its range: the field (its name in the settings struct and in a case file's
+/// section, e.g. `path_terms` or `sharpness[2]`) and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct SettingsError {
+    /// The field.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}

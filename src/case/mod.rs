@@ -4,6 +4,7 @@
 //! unit system; angles in radians.
 
 pub mod frame;
+pub mod grasp;
 mod limits;
 pub mod plan;
 mod strict_json;
@@ -12,7 +13,6 @@ pub use limits::*;
 
 use crate::constraints::{Angle, Bound};
 use crate::error::Error;
-use crate::optim::AlOptions;
 use crate::rod::basis::Basis;
 use crate::rod::layout::{Field, Layout};
 use crate::rod::model::Discretisation;
@@ -20,6 +20,7 @@ use crate::rod::{Profile, Rod};
 use crate::scene::obstacle::{Obstacle, ObstacleShape};
 use crate::statics::StaticOptions;
 use crate::statics::problem::StaticProblem;
+use crate::statics::{StaticProblemBuilder, StaticSettings};
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{
     Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags,
@@ -71,7 +72,7 @@ pub struct CaseFile {
     pub report_points: Option<Vec<f64>>,
     /// Solver settings.
     #[serde(default)]
-    pub solver: SolverSpec,
+    pub solver: StaticSettings,
     /// Path-planning settings (read by `dlo plan`).
     #[serde(default, deserialize_with = "strict_json::optional")]
     pub plan: Option<serde_json::Value>,
@@ -318,48 +319,6 @@ pub struct ShapeSpec {
     pub eps: Option<Vec<f64>>,
 }
 
-/// `solver` section.
-#[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SolverSpec {
-    /// Constraint violation tolerance (positions in units of `L`).
-    pub feasibility_tol: f64,
-    /// KKT residual tolerance (energies in units of `Rf/L`).
-    pub optimality_tol: f64,
-    /// Initial penalty (dimensionless).
-    pub rho_initial: f64,
-    /// Penalty cap.
-    pub rho_max: f64,
-    /// Outer iterations.
-    pub max_outer: usize,
-    /// Inner (Newton) iterations per outer iteration.
-    pub max_inner: usize,
-    /// Size (radians) of the deterministic perturbation added to the natural state when no
-    /// `shape` is given (the straight rod is stationary, see the README).
-    pub perturbation: f64,
-    /// Compute the stability verdict.
-    pub stability: bool,
-    /// Second-order (dual Newton) multiplier updates instead of `λ + ρc`.
-    pub second_order_multipliers: bool,
-}
-
-impl Default for SolverSpec {
-    fn default() -> Self {
-        let al = AlOptions::default();
-        SolverSpec {
-            feasibility_tol: al.feasibility_tol,
-            optimality_tol: al.optimality_tol,
-            rho_initial: al.rho_initial,
-            rho_max: al.rho_max,
-            max_outer: al.max_outer,
-            max_inner: al.max_inner,
-            perturbation: 0.1,
-            stability: true,
-            second_order_multipliers: al.newton_multipliers,
-        }
-    }
-}
-
 /// A validated case.
 #[derive(Clone, Debug)]
 pub struct Case {
@@ -371,6 +330,8 @@ pub struct Case {
     pub path: PathBuf,
     /// The static problem.
     pub problem: StaticProblem,
+    /// How it is built (the grasp margin rebuilds it with a split basis and a disturbance).
+    pub builder: StaticProblemBuilder,
     /// Obstacles (also inside the problem's constraints).
     pub obstacles: Vec<Arc<Obstacle>>,
     /// Start of the solve, or the shape to evaluate.
@@ -453,24 +414,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    build(file, path, None)
-}
-
-/// The case of `file` with its basis split at `s_split` (paper §6.2: two coefficient sets,
-/// continuous there) and `extra` point forces added; the explicit `shape`, whose length belongs
-/// to the unsplit basis, is dropped.
-pub fn variant(
-    file: &CaseFile,
-    path: &Path,
-    s_split: Option<f64>,
-    extra: &[ForceSpec],
-) -> Result<Case, Error> {
-    let mut f = file.clone();
-    f.forces.extend(extra.iter().cloned());
-    if s_split.is_some() {
-        f.shape = None;
-    }
-    build(f, path, s_split)
+    build(file, path)
 }
 
 pub(crate) struct V<'a> {
@@ -523,7 +467,7 @@ impl V<'_> {
     }
 }
 
-fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Error> {
+fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     let v = V { path };
     let r = &file.rod;
     let l = v.positive("rod.length", r.length)?;
@@ -582,11 +526,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         radius,
     };
     let layout = Layout {
-        basis: match s_split {
-            Some(sa) => Basis::split_at(d.basis_pairs, v.arc("split", sa, l)?),
-            None => Basis::new(d.basis_pairs),
-        }
-        .of_kind(d.basis),
+        basis: Basis::new(d.basis_pairs).of_kind(d.basis),
         spatial: !file.planar,
         extensible: r.extensional_rigidity.is_some(),
         free_base: file.base.free,
@@ -619,9 +559,6 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         .samples(d.samples)
         .base(base)
         .self_contact(file.self_contact);
-    if let Some(sa) = s_split {
-        builder = builder.register_point(sa);
-    }
     for (i, f) in file.forces.iter().enumerate() {
         v.arc(&format!("forces[{i}].s"), f.s, l)?;
         let force = v.vec3(&format!("forces[{i}].force"), f.force)?;
@@ -839,6 +776,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         builder = builder.obstacle(ob, margin);
     }
     let problem = builder
+        .clone()
         .build()
         .map_err(|e| v.err("constraints", e.to_string()))?;
     let (initial, explicit_shape) = match &file.shape {
@@ -873,35 +811,10 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         }
         None => (0..=4).map(|j| j as f64 * l / 4.0).collect(),
     };
-    let sv = file.solver;
-    for (nm, val) in [
-        ("solver.feasibility_tol", sv.feasibility_tol),
-        ("solver.optimality_tol", sv.optimality_tol),
-        ("solver.rho_initial", sv.rho_initial),
-        ("solver.rho_max", sv.rho_max),
-    ] {
-        v.positive(nm, val)?;
-    }
-    v.finite("solver.perturbation", sv.perturbation)?;
-    if sv.rho_max < sv.rho_initial {
-        return Err(v.err("solver.rho_max", "must be at least solver.rho_initial"));
-    }
-    if sv.max_outer == 0 || sv.max_inner == 0 {
-        return Err(v.err("solver.max_outer", "iteration budgets must be positive"));
-    }
-    let options = StaticOptions {
-        al: AlOptions {
-            feasibility_tol: sv.feasibility_tol,
-            optimality_tol: sv.optimality_tol,
-            rho_initial: sv.rho_initial,
-            rho_max: sv.rho_max,
-            max_outer: sv.max_outer,
-            max_inner: sv.max_inner,
-            newton_multipliers: sv.second_order_multipliers,
-            ..AlOptions::default()
-        },
-        stability: sv.stability,
-    };
+    file.solver
+        .validate()
+        .map_err(|e| v.err(format!("solver.{}", e.field), e.message))?;
+    let options = file.solver.options();
     let name = file.name.clone().unwrap_or_else(|| {
         path.file_stem()
             .map_or("case".into(), |s| s.to_string_lossy().into_owned())
@@ -914,6 +827,7 @@ fn build(file: CaseFile, path: &Path, s_split: Option<f64>) -> Result<Case, Erro
         description: file.description.clone(),
         path: path.to_path_buf(),
         problem,
+        builder,
         obstacles,
         initial,
         explicit_shape,

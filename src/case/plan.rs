@@ -326,7 +326,7 @@ impl crate::planner::Planner {
             start,
             goal,
             initial: case.initial.clone(),
-            static_settings: case.options,
+            static_settings: case.file.solver,
         };
         Planner::new(problem, settings).map_err(|e| match e {
             PlanSetupError::Settings(s) => {

@@ -10,48 +10,92 @@
 //! solved on that interpolation (exact where the forces are linear in `f`).
 
 use super::fingers::{ContactForce, Finger, contact_forces, fingers, friction_ratio};
-use crate::case::{Case, ForceSpec, variant};
-use crate::error::Error;
+use crate::statics::builder::{BuildError, StaticProblemBuilder};
 use crate::statics::problem::StaticProblem;
-use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static, solve_static_warm};
-use serde::Serialize;
+use crate::statics::{
+    SolveStatus, StaticOptions, StaticSettings, StaticSolution, solve_static, solve_static_warm,
+};
+use serde::{Deserialize, Serialize};
 
-/// Settings of a margin computation (the case's `grasp` section).
-#[derive(Clone, Debug, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GraspSpec {
+/// What to rate: the held rod (fingers are its position constraints with one unilateral bound,
+/// see [`super::fingers`]) as a recipe, so that the margin can rebuild it with the basis split
+/// at each point of action.
+#[derive(Clone, Debug)]
+pub struct GraspProblem {
+    /// The grasped rod's static problem, unbuilt.
+    pub statics: StaticProblemBuilder,
+    /// The start of the undisturbed solve.
+    pub initial: Vec<f64>,
+    /// Static solver settings (the disturbed solves use them without stability checks and with
+    /// a relative optimality tolerance no tighter than 1e-5).
+    pub static_settings: StaticSettings,
+}
+
+/// Disturbance directions: a number spread evenly in the x–z plane, or explicit vectors
+/// `[n_z, n_x]` (planar, the paper's order) / `[n_x, n_y, n_z]` (3D).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Directions {
+    /// Evenly spread directions.
+    Count(u64),
+    /// Explicit vectors (any length).
+    Vectors(Vec<Vec<f64>>),
+}
+
+/// Settings of a margin computation: the case file's `grasp` section.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GraspSettings {
     /// Pinch preload `r0` (case force units); required when the grasp has a pinch.
     pub preload: Option<f64>,
     /// Points of action `s_a` (case length units). Default: nine points `L(j+1)/10`.
     pub points: Option<Vec<f64>>,
     /// Directions: a number of evenly spread directions in the x–z plane, or explicit vectors
     /// `[n_z, n_x]` (planar) / `[n_x, n_y, n_z]` (3D). Default: 9.
-    pub directions: Option<serde_json::Value>,
+    pub directions: Option<Directions>,
     /// Friction coefficients. Default: 0.1, 0.2, …, 1.0.
     pub mu: Option<Vec<f64>>,
     /// Largest disturbance searched (case force units). Default: 5 × the largest initial
     /// contact normal force.
     pub f_max: Option<f64>,
     /// Continuation steps up to `f_max`.
-    #[serde(default = "d_steps")]
     pub steps: usize,
-    /// Bisections of the step where a contact is lost.
-    #[serde(default = "d_bisect")]
+    /// Bisections of the step where a contact is lost (at most 60 are used).
     pub bisections: usize,
 }
 
-fn d_steps() -> usize {
-    10
+impl Default for GraspSettings {
+    fn default() -> Self {
+        GraspSettings {
+            preload: None,
+            points: None,
+            directions: None,
+            mu: None,
+            f_max: None,
+            steps: 10,
+            bisections: 6,
+        }
+    }
 }
-fn d_bisect() -> usize {
-    6
+
+/// Why a grasp cannot be rated: the field (a key of [`GraspSettings`], or `constraints` for
+/// the grasp itself) and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct GraspSetupError {
+    /// The field, e.g. `preload` or `points[2]`.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
 }
 
 /// A validated grasp problem with its undisturbed solution.
 #[derive(Clone, Debug)]
 pub struct Grasp {
-    /// The case.
-    pub case: Case,
+    /// The problem.
+    pub problem: GraspProblem,
+    /// Its static problem, built.
+    pub base: StaticProblem,
     /// The undisturbed grasp.
     pub initial: StaticSolution,
     /// Its contact forces.
@@ -120,7 +164,7 @@ pub struct Margin {
 impl Grasp {
     /// The undisturbed grasp's shape (case units, at the model's mesh boundaries).
     pub fn initial_points(&self) -> Vec<[f64; 3]> {
-        let model = &self.case.problem.model;
+        let model = &self.base.model;
         let l = model.rod.length;
         model
             .evaluate(&self.initial.a)
@@ -144,25 +188,21 @@ impl Grasp {
             .collect()
     }
 
-    /// Validates the `grasp` section and solves the undisturbed grasp.
-    pub fn from_case(case: &Case) -> Result<Grasp, Error> {
+    /// Checks `settings` and solves the undisturbed grasp.
+    pub fn new(problem: GraspProblem, spec: GraspSettings) -> Result<Grasp, GraspSetupError> {
         /// The most force limits one margin computes (points × directions).
         const MAX_LIMITS: usize = 10_000;
-        let path = &case.path;
-        let err = |f: &str, m: String| Error::invalid(path, f, m);
-        let spec: GraspSpec = match &case.grasp {
-            Some(v) => {
-                serde_json::from_value(v.clone()).map_err(|e| err("grasp", e.to_string()))?
-            }
-            None => {
-                return Err(err(
-                    "grasp",
-                    "missing: `dlo margin` needs a `grasp` section".into(),
-                ));
-            }
+        let err = |f: &str, m: String| GraspSetupError {
+            field: f.to_string(),
+            message: m,
         };
-        let l = case.problem.model.rod.length;
-        let fingers = fingers(&case.problem);
+        let base = problem
+            .statics
+            .clone()
+            .build()
+            .map_err(|e| err("constraints", e.to_string()))?;
+        let l = base.model.rod.length;
+        let fingers = fingers(&base);
         if fingers.is_empty() {
             return Err(err(
                 "constraints",
@@ -172,22 +212,19 @@ impl Grasp {
         let has_pinch = fingers.iter().any(|f| f.pinch_with.is_some());
         let preload = match (spec.preload, has_pinch) {
             (Some(p), _) if !(p.is_finite() && p >= 0.0) => {
-                return Err(err(
-                    "grasp.preload",
-                    format!("must be finite and ≥ 0, got {p}"),
-                ));
+                return Err(err("preload", format!("must be finite and ≥ 0, got {p}")));
             }
             (Some(p), _) => p,
             (None, true) => {
                 return Err(err(
-                    "grasp.preload",
+                    "preload",
                     "required: the grasp has a pinch, whose squeeze rigid fingers leave undetermined".into(),
                 ));
             }
             (None, false) => 0.0,
         };
-        let mut p = case.problem.clone();
-        let initial = solve_static(&mut p, &case.initial, &case.options);
+        let mut p = base.clone();
+        let initial = solve_static(&mut p, &problem.initial, &problem.static_settings.options());
         if initial.status != SolveStatus::Converged {
             return Err(err(
                 "constraints",
@@ -203,52 +240,45 @@ impl Grasp {
             .clone()
             .unwrap_or_else(|| (1..=9).map(|j| l * j as f64 / 10.0).collect());
         if points.is_empty() {
-            return Err(err(
-                "grasp.points",
-                "needs at least one point of action".into(),
-            ));
+            return Err(err("points", "needs at least one point of action".into()));
         }
         if points.len() > 10_000 {
             return Err(err(
-                "grasp.points",
+                "points",
                 format!("at most 10000 points, got {}", points.len()),
             ));
         }
         for (i, s) in points.iter().enumerate() {
             if !(s.is_finite() && *s > 0.0 && *s < l) {
                 return Err(err(
-                    &format!("grasp.points[{i}]"),
+                    &format!("points[{i}]"),
                     format!("must be inside (0, {l}), got {s}"),
                 ));
             }
         }
-        let spatial = case.problem.model.layout.spatial;
+        let spatial = base.model.layout.spatial;
         let directions = match &spec.directions {
             None => even_directions(9),
-            Some(serde_json::Value::Number(n)) => {
-                let k = n
-                    .as_u64()
-                    .filter(|k| (1..=360).contains(k))
-                    .ok_or_else(|| {
-                        err(
-                            "grasp.directions",
-                            format!("a count must be in 1..=360, got {n}"),
-                        )
-                    })?;
-                even_directions(k as usize)
+            Some(Directions::Count(n)) => {
+                if !(1..=360).contains(n) {
+                    return Err(err(
+                        "directions",
+                        format!("a count must be in 1..=360, got {n}"),
+                    ));
+                }
+                even_directions(*n as usize)
             }
-            Some(serde_json::Value::Array(list)) => {
+            Some(Directions::Vectors(list)) => {
                 if list.len() > 360 {
                     return Err(err(
-                        "grasp.directions",
+                        "directions",
                         format!("a list holds at most 360 directions, got {}", list.len()),
                     ));
                 }
                 let mut out = Vec::new();
                 for (i, d) in list.iter().enumerate() {
-                    let f = format!("grasp.directions[{i}]");
-                    let v: Vec<f64> = serde_json::from_value(d.clone())
-                        .map_err(|_| err(&f, "must be a list of numbers".into()))?;
+                    let f = format!("directions[{i}]");
+                    let v = d;
                     let v3 = match (spatial, v.len()) {
                         (false, 2) => [v[1], 0.0, v[0]],
                         (true, 3) => [v[0], v[1], v[2]],
@@ -274,24 +304,15 @@ impl Grasp {
                     out.push(v3.map(|c| c / norm));
                 }
                 if out.is_empty() {
-                    return Err(err(
-                        "grasp.directions",
-                        "needs at least one direction".into(),
-                    ));
+                    return Err(err("directions", "needs at least one direction".into()));
                 }
                 out
-            }
-            Some(_) => {
-                return Err(err(
-                    "grasp.directions",
-                    "a count or a list of vectors".into(),
-                ));
             }
         };
         // Each (point, direction) pair is a continuation of about 16 solves.
         if points.len() * directions.len() > MAX_LIMITS {
             return Err(err(
-                "grasp.points",
+                "points",
                 format!(
                     "{} points × {} directions = {} force limits; at most {MAX_LIMITS}",
                     points.len(),
@@ -305,15 +326,12 @@ impl Grasp {
             .clone()
             .unwrap_or_else(|| (1..=10).map(|j| j as f64 / 10.0).collect());
         if mu.is_empty() {
-            return Err(err(
-                "grasp.mu",
-                "needs at least one friction coefficient".into(),
-            ));
+            return Err(err("mu", "needs at least one friction coefficient".into()));
         }
         for (i, m) in mu.iter().enumerate() {
             if !(m.is_finite() && *m >= 0.0) {
                 return Err(err(
-                    &format!("grasp.mu[{i}]"),
+                    &format!("mu[{i}]"),
                     format!("must be finite and ≥ 0, got {m}"),
                 ));
             }
@@ -321,15 +339,15 @@ impl Grasp {
         let n0 = initial_forces.iter().map(|c| c.normal).fold(0.0, f64::max);
         let f_max = spec.f_max.unwrap_or(5.0 * n0.max(preload));
         if !(f_max.is_finite() && f_max > 0.0) {
-            return Err(err("grasp.f_max", format!("must be positive, got {f_max}")));
+            return Err(err("f_max", format!("must be positive, got {f_max}")));
         }
         // The search bisects [0, f_max]: a cap many decades above the rod's force scale leaves
         // the bisection at that scale's resolution and reports a margin there.
-        let fu = case.problem.model.rod.force_unit();
+        let fu = base.model.rod.force_unit();
         let f_cap = 1e6 * fu.max(n0).max(preload);
         if f_max > f_cap {
             return Err(err(
-                "grasp.f_max",
+                "f_max",
                 format!(
                     "{f_max} is more than 10⁶ times the rod's force scale (Rf/L² = {fu:.3e}, the largest initial contact force {n0:.3e}, the preload {preload:.3e}): at most {f_cap:.3e}"
                 ),
@@ -337,12 +355,14 @@ impl Grasp {
         }
         if spec.steps == 0 || spec.steps > 10_000 {
             return Err(err(
-                "grasp.steps",
+                "steps",
                 format!("must be in 1..=10000, got {}", spec.steps),
             ));
         }
+        let static_settings = problem.static_settings.options();
         Ok(Grasp {
-            case: case.clone(),
+            problem,
+            base,
             initial,
             initial_forces,
             fingers,
@@ -358,7 +378,7 @@ impl Grasp {
             options: {
                 let mut o = StaticOptions {
                     stability: false,
-                    ..case.options
+                    ..static_settings
                 };
                 o.al.optimality_tol = o.al.optimality_tol.max(1e-5);
                 o
@@ -372,18 +392,19 @@ impl Grasp {
         &self,
         s_a: f64,
         n: [f64; 3],
-    ) -> Result<(StaticProblem, Vec<f64>), Error> {
-        let m = &self.case.problem.model;
+    ) -> Result<(StaticProblem, Vec<f64>), BuildError> {
+        let m = &self.base.model;
         let l = m.rod.length;
         let x0 = m.position_at(&self.initial.a, s_a / l).map(|c| c * l);
-        let load = ForceSpec {
-            s: s_a,
-            force: n,
-            reference: x0,
-        };
-        let c = variant(&self.case.file, &self.case.path, Some(s_a), &[load])?;
+        let disturbed = self
+            .problem
+            .statics
+            .clone()
+            .split_at(s_a)
+            .load(s_a, n, x0)
+            .build()?;
         // Map the undisturbed coefficients: left set = a, right increment = 0.
-        let lay = c.problem.model.layout;
+        let lay = disturbed.model.layout;
         let old = m.layout;
         let mut a = vec![0.0; lay.len()];
         for f in [
@@ -401,7 +422,7 @@ impl Grasp {
             let k = lay.components().len();
             a[bn..bn + k].copy_from_slice(&self.initial.a[bo..bo + k]);
         }
-        Ok((c.problem, a))
+        Ok((disturbed, a))
     }
 
     /// Solves the disturbed grasp at magnitude `f` (case force units) from `from`.
@@ -427,7 +448,7 @@ impl Grasp {
     }
 
     /// `F(s_a, n)` for every `μ`.
-    pub fn limit(&self, s_a: f64, n: [f64; 3]) -> Result<Limit, Error> {
+    pub fn limit(&self, s_a: f64, n: [f64; 3]) -> Result<Limit, BuildError> {
         let (mut p, a0) = self.disturbed_problem(s_a, n)?;
         let scale = self
             .initial_forces
@@ -550,7 +571,7 @@ impl Grasp {
 
     /// The margin over every point and direction, in parallel; `progress(done, total)` is called
     /// as limits complete.
-    pub fn margin(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Margin, Error> {
+    pub fn margin(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Margin, BuildError> {
         let jobs: Vec<(f64, [f64; 3])> = self
             .points
             .iter()
@@ -561,7 +582,8 @@ impl Grasp {
         let workers = std::thread::available_parallelism()
             .map_or(1, |n| n.get())
             .min(total.max(1));
-        let mut results: Vec<Option<Result<Limit, Error>>> = (0..total).map(|_| None).collect();
+        let mut results: Vec<Option<Result<Limit, BuildError>>> =
+            (0..total).map(|_| None).collect();
         std::thread::scope(|sc| {
             let handles: Vec<_> = (0..workers)
                 .map(|w| {

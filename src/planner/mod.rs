@@ -1,7 +1,7 @@
 //! Deformation path planning (paper §7): the minimax-energy path in coefficient space between
 //! two static shapes, verified on a finer grid and replayed by the controlled end alone.
 //!
-//! [`Planner::from_case`] solves the start and goal shapes; [`Planner::run`] optimises, verifies
+//! [`Planner::new`] (or [`Planner::from_case`]) solves the start and goal shapes; [`Planner::run`] optimises, verifies
 //! and replays, telling a [`PlanObserver`] every shape it computes.
 
 mod clear_samples;
@@ -22,18 +22,19 @@ pub mod trajectory;
 pub mod verify;
 
 use crate::constraints::{Angle, Constraint};
+pub use crate::error::SettingsError;
 use crate::optim::AlStatus;
 use crate::planner::path::DeformationPath;
 use crate::rod::kinematics::Shape;
 use crate::scene::obstacle::Obstacle;
 use crate::statics::problem::StaticProblem;
-use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static};
+use crate::statics::{SolveStatus, StaticOptions, StaticSettings, StaticSolution, solve_static};
 pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, ShapeRecord};
 use replay::{ReplayOptions, replay};
-pub use settings::{Optimiser, PlanSettings, SettingsError};
+pub use settings::{Optimiser, PlanSettings};
 use std::sync::Arc;
 use verify::fine_model;
 
@@ -57,7 +58,7 @@ pub struct PlanProblem {
     pub initial: Vec<f64>,
     /// Settings of the static solves (start, goal, replay); their optimality tolerance is
     /// taken no tighter than 1e-5 and their Newton steps no longer than 0.1.
-    pub static_settings: StaticOptions,
+    pub static_settings: StaticSettings,
 }
 
 impl PlanProblem {
@@ -79,7 +80,7 @@ impl PlanProblem {
             start,
             goal,
             initial,
-            static_settings: StaticOptions::default(),
+            static_settings: StaticSettings::default(),
         }
     }
 }
@@ -386,7 +387,7 @@ impl Planner {
         }
         // Replay and endpoint solves: the problem's settings, with the optimality tolerance no
         // tighter than 1e-5 (replayed shapes are compared at the 1e-3 L level).
-        let mut static_options = problem.static_settings;
+        let mut static_options = problem.static_settings.options();
         static_options.al.optimality_tol = static_options.al.optimality_tol.max(1e-5);
         // Newton steps of at most 0.1 per coefficient: replay and tracking solves continue from
         // the previous shape and must stay on its branch of equilibria (unlimited steps let a

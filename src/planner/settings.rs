@@ -94,15 +94,7 @@ impl Default for PlanSettings {
     }
 }
 
-/// A setting out of its range: the field (a key of [`PlanSettings`]) and why.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct SettingsError {
-    /// The field, e.g. `path_terms` or `sharpness[2]`.
-    pub field: String,
-    /// What is wrong.
-    pub message: String,
-}
+use crate::error::SettingsError;
 
 fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
     SettingsError {

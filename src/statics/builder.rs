@@ -29,6 +29,7 @@ use crate::constraints::{
     PositionConstraint, RelativePositionConstraint, SelfContactConstraint,
 };
 use crate::rod::Rod;
+use crate::rod::basis::Basis;
 use crate::rod::layout::{Field, Layout};
 use crate::rod::model::{Discretisation, Model, PointLoad};
 use crate::scene::Obstacle;
@@ -234,6 +235,15 @@ impl StaticProblemBuilder {
     pub fn self_contact(mut self, on: bool) -> Self {
         self.self_contact = on;
         self
+    }
+
+    /// Splits the basis at `s` into two coefficient sets joined continuously there (a point
+    /// load's kink in the curvature), and makes `s` a mesh boundary.
+    pub fn split_at(mut self, s: f64) -> Self {
+        let basis = self.layout.basis;
+        self.layout.basis =
+            Basis::split_at(basis.pairs(), s / self.rod.length).of_kind(basis.kind());
+        self.register_point(s)
     }
 
     /// Makes `s` a mesh boundary without constraining it (e.g. a basis split point).

@@ -6,9 +6,11 @@ pub mod balance;
 pub mod builder;
 pub mod problem;
 pub mod report;
+pub mod settings;
 mod solve;
 pub mod stability;
 
 pub use builder::{BuildError, StaticProblemBuilder};
 pub use problem::StaticProblem;
+pub use settings::StaticSettings;
 pub use solve::*;
