@@ -9,7 +9,7 @@
 use super::writer::LogError;
 
 /// Largest record (or decompressed chunk) accepted from a file of `len` bytes: 64 times the file
-/// (zstd rarely compresses our logs 10:1), at least 16 MiB and at most 1 GiB.
+/// (LZ4 rarely compresses our logs 10:1), at least 16 MiB and at most 1 GiB.
 pub fn record_limit(len: usize) -> usize {
     len.saturating_mul(64).clamp(16 << 20, 1 << 30)
 }
