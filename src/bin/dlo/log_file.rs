@@ -1,0 +1,80 @@
+//! A run's files: the log written under a partial name, finished and moved into place (also on
+//! Ctrl-C and SIGTERM), and other outputs written atomically.
+
+use super::*;
+
+/// The log being written and its final path, finished and moved into place by the Ctrl-C
+/// (and SIGTERM) handler.
+pub(crate) static ACTIVE_LOG: OnceLock<(SharedWriter, PathBuf)> = OnceLock::new();
+
+/// Where the log bound for `path` is written until it is finished: a name of this process's own
+/// beside it, so that a run killed hard leaves the previous run's finished log whole (and its
+/// own finished chunks, for `dlo recover`), and two runs at once never write one file.
+pub(crate) fn partial_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".{}.partial", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Opens the log bound for `dir/<name>.mcap` (under [`partial_path`], its header on disk at
+/// once) and arms the Ctrl-C and SIGTERM handler to finish it.
+pub(crate) fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode> {
+    let path = dir.join(format!("{name}.mcap"));
+    let tmp = partial_path(&path);
+    let created = McapWriter::create(&tmp).and_then(|mut w| w.flush().map(|()| w));
+    let w = created.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        eprintln!(
+            "error: {}: cannot create the log: {}",
+            path.display(),
+            causes(&e)
+        );
+        ExitCode::from(EXIT_OUTPUT)
+    })?;
+    let shared: SharedWriter = Arc::new(Mutex::new(w));
+    if ACTIVE_LOG.set((shared.clone(), path.clone())).is_ok() {
+        let _ = ctrlc::set_handler(|| {
+            if let Some((w, path)) = ACTIVE_LOG.get() {
+                let mut w = dlo_planner::output::mcap_log::lock(w);
+                if w.finish().is_ok() {
+                    let _ = std::fs::rename(partial_path(path), path);
+                }
+            }
+            eprintln!("interrupted: the log was finished and is readable");
+            std::process::exit(EXIT_INTERRUPTED);
+        });
+    }
+    Ok((shared, path))
+}
+
+/// Finishes a log and moves it into place; reports failure as exit code 1 and then leaves no
+/// half-written file.
+pub(crate) fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
+    let tmp = partial_path(path);
+    let mut guard = dlo_planner::output::mcap_log::lock(w);
+    let was_open = !guard.is_finished();
+    let finished = guard.finish().map_err(|e| causes(&e));
+    drop(guard);
+    let moved = match finished {
+        Ok(()) if was_open => std::fs::rename(&tmp, path).map_err(|e| e.to_string()),
+        other => other,
+    };
+    moved.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        eprintln!("error: {}: cannot finish the log: {e}", path.display());
+        ExitCode::from(EXIT_OUTPUT)
+    })
+}
+
+/// Writes `text` to `path` through a temporary file ([`partial_path`], as the log) moved into
+/// place, so that a failed write leaves no half-written file (and an earlier run's file stays
+/// whole until the new one is).
+pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<(), ExitCode> {
+    let tmp = partial_path(path);
+    let written = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
+    written.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        eprintln!("error: {}: cannot write: {e}", path.display());
+        ExitCode::from(EXIT_OUTPUT)
+    })
+}

@@ -1,0 +1,31 @@
+//! Writing to stdout and describing errors.
+
+/// Set when stdout could not be written (other than a closed pipe): the run then exits with 1.
+pub(crate) static STDOUT_FAILED: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Writes to stdout. A closed pipe (e.g. `dlo shape … | head`) ends the output quietly; any
+/// other failure (a full device) is reported and makes the exit code 1.
+pub(crate) fn emit(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let written = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+    if let Err(e) = written
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+        && !STDOUT_FAILED.swap(true, std::sync::atomic::Ordering::SeqCst)
+    {
+        eprintln!("error: stdout: cannot write: {e}");
+    }
+}
+
+/// An error and its chain of causes, `outer: inner: …` (the MCAP crate wraps I/O errors in a
+/// generic message whose cause says what went wrong).
+pub(crate) fn causes(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(&format!(": {s}"));
+        source = s.source();
+    }
+    text
+}

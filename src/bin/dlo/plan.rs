@@ -1,0 +1,345 @@
+//! `dlo plan`: the plan's progress, report, summary and exit code.
+
+use super::*;
+
+/// Progress on stderr (only when it is a terminal) plus the MCAP log.
+pub(crate) struct CliObserver {
+    log: PlanLog,
+    tty: bool,
+    started: Instant,
+}
+
+impl PlanObserver for CliObserver {
+    fn begin(&mut self, model: &dlo_planner::rod::model::Model) {
+        self.log.begin(model);
+    }
+    fn phase(&mut self, name: &str) {
+        self.log.phase(name);
+        if self.tty {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] {name}",
+                self.started.elapsed().as_secs_f64()
+            );
+        }
+    }
+    fn shape(&mut self, model: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
+        self.log.shape(model, r);
+        if self.tty && r.kind == dlo_planner::planner::observer::PathKind::Feasible {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] replay k = {:.3}  d = {:.2e}",
+                self.started.elapsed().as_secs_f64(),
+                r.k,
+                r.deviation.unwrap_or(0.0)
+            );
+        }
+    }
+    fn progress(&mut self, model: &dlo_planner::rod::model::Model, p: &Progress, worst: &[f64]) {
+        self.log.progress(model, p, worst);
+        if self.tty {
+            eprint!(
+                "\r\x1b[2K[{:7.2} s] optimise start {} stage {} iteration {}: max U {:.4e} at k = {:.3}, violation {:.1e}",
+                self.started.elapsed().as_secs_f64(),
+                p.start,
+                p.stage,
+                p.outer,
+                p.sampled_max,
+                p.k_worst,
+                p.violation
+            );
+        }
+    }
+}
+
+#[derive(serde::Serialize)]
+pub(crate) struct PlanReport<'a> {
+    case: &'a str,
+    verdict: dlo_planner::planner::PlanVerdict,
+    #[serde(flatten)]
+    result: &'a dlo_planner::planner::PlanResult,
+    start_energy: f64,
+    goal_energy: f64,
+    mcap: String,
+    log_shapes: u64,
+    trajectory_csv: String,
+}
+
+/// The validated `--max-speed` and `--max-angular-speed` (the latter infinite when absent).
+pub(crate) fn speed_limits(v: Option<f64>, w: Option<f64>) -> Result<Option<[f64; 2]>, ExitCode> {
+    let Some(v) = v else { return Ok(None) };
+    let w = w.unwrap_or(f64::INFINITY);
+    for (name, x, inf_ok) in [("--max-speed", v, false), ("--max-angular-speed", w, true)] {
+        if !(x > 0.0 && (inf_ok || x.is_finite())) {
+            eprintln!("error: {name}: must be a positive finite number, got {x}");
+            return Err(ExitCode::from(EXIT_BAD_INPUT));
+        }
+    }
+    Ok(Some([v, w]))
+}
+
+pub(crate) fn run_plan(
+    path: &Path,
+    json: bool,
+    plot: bool,
+    log_dir: &Path,
+    speeds: Option<[f64; 2]>,
+) -> ExitCode {
+    let c = match load(path) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let t0 = Instant::now();
+    let planner = match Planner::from_case(&c) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let t_end = t0.elapsed().as_secs_f64();
+    let (log, log_path) = match open_log(log_dir, &c.name) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let mut obs = CliObserver {
+        log: PlanLog::new(log.clone(), c.obstacles.clone()),
+        tty: std::io::stderr().is_terminal(),
+        started: Instant::now(),
+    };
+    let mut result = planner.run(&mut obs);
+    result.timing_s.endpoints = t_end;
+    if let Some([v, w]) = speeds {
+        result.trajectory.time_parameterise(v, w);
+    }
+    if obs.tty {
+        eprintln!();
+    }
+    if let Some(e) = obs.log.error() {
+        eprintln!(
+            "error: {}: cannot write the log: {}",
+            log_path.display(),
+            causes(e)
+        );
+        let _ = close_log(&log, &log_path);
+        return ExitCode::from(EXIT_OUTPUT);
+    }
+    if let Err(code) = close_log(&log, &log_path) {
+        return code;
+    }
+    let csv_path = log_dir.join(format!("{}.trajectory.csv", c.name));
+    if let Err(code) = write_atomically(&csv_path, &result.trajectory.to_csv()) {
+        return code;
+    }
+    let report = PlanReport {
+        case: &c.name,
+        verdict: result.verdict(),
+        result: &result,
+        start_energy: planner.start.energy.internal(),
+        goal_energy: planner.goal.energy.internal(),
+        mcap: log_path.display().to_string(),
+        log_shapes: obs.log.shapes(),
+        trajectory_csv: csv_path.display().to_string(),
+    };
+    if json {
+        emit(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(&report).expect("report serialises")
+        ));
+    } else {
+        emit(&plan_summary(&report));
+    }
+    if plot {
+        let svg = log_path.with_extension("svg");
+        if run_plot(&log_path, &svg) != ExitCode::SUCCESS {
+            return ExitCode::from(EXIT_OUTPUT);
+        }
+    }
+    match result.verdict() {
+        PlanVerdict::SelfCollision => {
+            let (gap, k) = result.verification.self_contact.unwrap_or((0.0, 0.0));
+            eprintln!(
+                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}); {}",
+                path.display(),
+                TRY_COLLISION
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
+        PlanVerdict::ObstacleCollision => {
+            eprintln!(
+                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}); {}",
+                path.display(),
+                result.min_clearance.unwrap_or(0.0),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or("?", |o| o.obstacle.as_str()),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or(0.0, |o| o.k),
+                result
+                    .verification
+                    .obstacles
+                    .iter()
+                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+                    .map_or(0.0, |o| o.s),
+                TRY_COLLISION
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
+        PlanVerdict::NotConverged => {
+            eprintln!(
+                "error: {}: the path optimiser did not converge ({:?}, violation {:.2e})",
+                path.display(),
+                result.optimiser,
+                result.violation
+            );
+            ExitCode::from(EXIT_NOT_CONVERGED)
+        }
+        PlanVerdict::Departs | PlanVerdict::SnapsThrough => {
+            eprintln!(
+                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}; {}",
+                path.display(),
+                result.replay.max_deviation_over_l,
+                result.replay.k_at_max_deviation,
+                result.replay.tolerance,
+                if result.replay.snaps.is_empty() {
+                    String::new()
+                } else {
+                    format!(", snap-through at k = {}", snap_list(&result.replay.snaps))
+                },
+                TRY_DEPARTURE
+            );
+            ExitCode::from(EXIT_NOT_COINCIDENT)
+        }
+        PlanVerdict::Executable => ExitCode::SUCCESS,
+    }
+}
+
+/// What to try when no plan is collision-free (the case file's `plan` fields).
+pub(crate) const TRY_COLLISION: &str = "try plan.swept_clearance: true, more plan.k_samples, more path terms (plan.fallback_path_terms, e.g. [6, 8]) or more plan.starts";
+
+/// What to try when the replay departs from the plan.
+pub(crate) const TRY_DEPARTURE: &str = "try more path terms (plan.fallback_path_terms, e.g. [6, 8]), more plan.starts, or a stronger plan.equilibrium_weight; the replayed path in the log is what the controlled end does";
+
+pub(crate) fn plan_summary(r: &PlanReport) -> String {
+    use std::fmt::Write;
+    let p = r.result;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "case {}: {} ({}; optimiser {})",
+        r.case, r.verdict, p.status, p.optimiser
+    );
+    let _ = writeln!(
+        o,
+        "  U_max {:.6e} at k = {:.3} (optimiser's samples {:.6e})   straight path U_max {:.6e}   start {:.6e}  goal {:.6e}",
+        p.u_max, p.k_at_u_max, p.sampled_u_max, p.u_max_straight, r.start_energy, r.goal_energy
+    );
+    let _ = writeln!(
+        o,
+        "  clearance {}   straight path clearance {}   optimiser violation {:.2e}",
+        p.min_clearance.map_or("n/a".into(), |c| format!("{c:.4e}")),
+        p.min_clearance_straight
+            .map_or("n/a".into(), |c| format!("{c:.4e}")),
+        p.violation
+    );
+    if p.starts.len() + p.starts_not_run > 1 {
+        // Starts with fallback path terms ran: say which count each start used.
+        let fallback = p
+            .starts
+            .iter()
+            .any(|s| s.path_terms != p.starts[0].path_terms);
+        let not_run = if p.starts_not_run > 0 {
+            format!(
+                " ({} more not run: a plan is estimated to coincide)",
+                p.starts_not_run
+            )
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            o,
+            "  starts: {}{not_run}, chosen {} (path terms {}); verified U_max (sampled; samples' distance to their equilibria) {}",
+            p.starts.len(),
+            p.chosen_start,
+            p.path_terms,
+            p.starts
+                .iter()
+                .map(|s| {
+                    let clear = if s.collision_free { "" } else { ", collides" };
+                    let (u, us, st) = (s.u_max, s.sampled_u_max, s.status);
+                    let d = s
+                        .equilibrium_deviation
+                        .map_or("n/a".into(), |d| format!("{d:.4} L"));
+                    let m = if fallback {
+                        format!("m = {}: ", s.path_terms)
+                    } else {
+                        String::new()
+                    };
+                    format!("{m}{u:.4} ({us:.4}; {d}; {st:?}{clear})")
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let rp = &p.replay;
+    let _ = writeln!(
+        o,
+        "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snap-through at k = [{}]",
+        rp.max_deviation_over_l,
+        rp.k_at_max_deviation,
+        rp.tolerance,
+        if rp.coincide {
+            "coincide"
+        } else {
+            "DO NOT COINCIDE"
+        },
+        rp.u_max,
+        rp.all_stable,
+        rp.all_converged,
+        snap_list(&rp.snaps)
+    );
+    if let Some(c) = rp.min_clearance {
+        let contact = if rp.max_contact_force > 0.0 {
+            format!(
+                "leans on obstacles: largest contact force {:.4e} at k = {:.3}",
+                rp.max_contact_force, rp.k_at_max_contact_force
+            )
+        } else {
+            "touches no obstacle".to_string()
+        };
+        let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
+    }
+    let t = &p.trajectory;
+    let _ = writeln!(
+        o,
+        "  gripper: path length {:.4e} (straight line {:.4e}), largest step {:.4e}; turns {:.4} rad (largest step {:.4} rad){}; poses {}",
+        t.path_length,
+        t.straight_distance,
+        t.largest_step,
+        t.rotation_angle,
+        t.largest_rotation_step,
+        t.duration_s
+            .map_or(String::new(), |d| format!("; duration {d:.3} s")),
+        r.trajectory_csv
+    );
+    let _ = writeln!(
+        o,
+        "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",
+        r.mcap, r.log_shapes, p.timing_s.endpoints, p.timing_s.plan, p.timing_s.replay
+    );
+    o
+}
+
+/// The `k` of snap-throughs, four decimals each.
+pub(crate) fn snap_list(snaps: &[f64]) -> String {
+    snaps
+        .iter()
+        .map(|k| format!("{k:.4}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
