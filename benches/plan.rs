@@ -58,6 +58,7 @@ fn benches(c: &mut Criterion) {
                 opts,
                 &pl.static_options,
                 &mut Silent,
+                &std::sync::atomic::AtomicBool::new(false),
             )
         })
     });

@@ -76,6 +76,8 @@ pub enum AlStatus {
     Infeasible,
     /// A non-finite value appeared.
     NumericalFailure,
+    /// The caller stopped the run.
+    Interrupted,
 }
 
 impl std::fmt::Display for AlStatus {
@@ -85,6 +87,7 @@ impl std::fmt::Display for AlStatus {
             AlStatus::IterationLimit => "iteration limit reached",
             AlStatus::Infeasible => "infeasible",
             AlStatus::NumericalFailure => "numerical failure",
+            AlStatus::Interrupted => "interrupted",
         })
     }
 }
@@ -239,16 +242,17 @@ pub fn augmented_lagrangian<P: Nlp>(
     lambda0: Option<&[f64]>,
     opts: AlOptions,
 ) -> AlOutcome {
-    augmented_lagrangian_observed(p, x, lambda0, opts, &mut |_, _| {})
+    augmented_lagrangian_observed(p, x, lambda0, opts, &mut |_, _| true)
 }
 
-/// [`augmented_lagrangian`], calling `on_outer` after every outer iteration.
+/// [`augmented_lagrangian`], calling `on_outer` after every outer iteration; the run stops with
+/// [`AlStatus::Interrupted`] when it returns `false`.
 pub fn augmented_lagrangian_observed<P: Nlp>(
     p: &mut P,
     x: &mut [f64],
     lambda0: Option<&[f64]>,
     opts: AlOptions,
-    on_outer: &mut dyn FnMut(&OuterIterate, &P),
+    on_outer: &mut dyn FnMut(&OuterIterate, &P) -> bool,
 ) -> AlOutcome {
     let (n, m) = (p.n(), p.m());
     // A run started without multipliers on a stable equilibrium holds on to it.
@@ -402,7 +406,7 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
         if let Some(l) = dual_step {
             lambda = l;
         }
-        on_outer(
+        let go_on = on_outer(
             &OuterIterate {
                 outer,
                 f: f_now,
@@ -412,6 +416,10 @@ pub fn augmented_lagrangian_observed<P: Nlp>(
             },
             p,
         );
+        if !go_on {
+            status = AlStatus::Interrupted;
+            break;
+        }
         let inner_ok = out.grad_norm <= opts.optimality_tol
             || matches!(
                 out.status,

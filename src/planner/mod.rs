@@ -33,9 +33,10 @@ pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, ShapeRecord};
-use replay::{ReplayOptions, replay};
+use replay::{Replay, ReplayOptions, replay};
 pub use settings::{Optimiser, PlanSettings};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
 use refine::Verified;
@@ -123,6 +124,8 @@ pub struct Planner {
     pub goal: StaticSolution,
     /// Rows of the fixed conditions that are linear in the coefficients.
     pub linear_rows: Vec<Vec<f64>>,
+    /// Set to stop a run (see [`Planner::stop_handle`]).
+    stop: Arc<AtomicBool>,
 }
 
 /// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
@@ -417,7 +420,29 @@ impl Planner {
             start,
             goal,
             linear_rows,
+            stop: Arc::new(AtomicBool::new(false)),
         })
+    }
+
+    /// A flag that stops a run of this planner (from another thread, or a signal handler)
+    /// when set: the run finishes the phase's current iteration, skips what is left (the
+    /// replay among it) and returns with status [`PlanStatus::Interrupted`]. A
+    /// [`PlanObserver::stop_requested`] that returns `true` sets it.
+    pub fn stop_handle(&self) -> Arc<AtomicBool> {
+        self.stop.clone()
+    }
+
+    /// Whether the run has been asked to stop.
+    pub(crate) fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    /// Asks `observer` whether to stop, and sets the flag if so (on the run's own thread).
+    pub(crate) fn poll(&self, observer: &mut dyn PlanObserver) -> bool {
+        if observer.stop_requested() {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        self.stopped()
     }
 
     /// The optimiser's extra clearance from obstacles in units of `L` (see
@@ -528,6 +553,7 @@ impl Planner {
         }
 
         observer.phase("optimise");
+        self.poll(observer);
         let tol = self.collision_tolerance();
         let runs = self.run_starts(&fine, observer);
         // The plan is the start whose verified path is best: collision-free first, then feasible
@@ -556,23 +582,32 @@ impl Planner {
 
         observer.phase("replay");
         let t1 = std::time::Instant::now();
-        let rep = replay(
-            &self.base,
-            &self.start,
-            &path,
-            &chosen.z,
-            ReplayOptions {
-                steps: self.settings.replay_steps,
-                refinements: self.settings.replay_refinements,
-                tolerance: self.settings.coincide_tolerance,
-            },
-            &self.static_options,
-            observer,
-        );
+        let interrupted = self.poll(observer);
+        let rep = if interrupted {
+            Replay::not_run(self.settings.coincide_tolerance)
+        } else {
+            replay(
+                &self.base,
+                &self.start,
+                &path,
+                &chosen.z,
+                ReplayOptions {
+                    steps: self.settings.replay_steps,
+                    refinements: self.settings.replay_refinements,
+                    tolerance: self.settings.coincide_tolerance,
+                },
+                &self.static_options,
+                observer,
+                &self.stop,
+            )
+        };
+        let interrupted = interrupted || self.stopped();
         let t_replay = t1.elapsed().as_secs_f64();
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
         let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
-        let status = if !ver.collision_free(tol) {
+        let status = if interrupted {
+            PlanStatus::Interrupted
+        } else if !ver.collision_free(tol) {
             PlanStatus::Collision
         } else if chosen.status != AlStatus::Converged {
             PlanStatus::NotConverged

@@ -76,6 +76,11 @@ pub trait PlanObserver {
     fn shape(&mut self, _model: &Model, _record: &ShapeRecord) {}
     /// The optimiser finished an outer iteration; `worst` is the shape at `k_worst`.
     fn progress(&mut self, _model: &Model, _p: &Progress, _worst: &[f64]) {}
+    /// Asked after every progress report, at every phase and at every replay step: `true`
+    /// stops the run (see [`super::Planner::stop_handle`]).
+    fn stop_requested(&mut self) -> bool {
+        false
+    }
 }
 
 /// An observer that ignores everything.

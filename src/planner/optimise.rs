@@ -136,21 +136,24 @@ impl Planner {
                             },
                             q.sampled()[j].clone(),
                         );
+                        !self.stopped()
                     },
                 )
             };
-            if tally.absorb(out) {
+            if tally.absorb(out) || self.stopped() {
                 break;
             }
         }
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
-        let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) =
-            if tally.status != AlStatus::NumericalFailure {
-                self.track(&mut p, &mut z, &mut tally, al)
-            } else {
-                (0, 0, None)
-            };
+        let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if !matches!(
+            tally.status,
+            AlStatus::NumericalFailure | AlStatus::Interrupted
+        ) {
+            self.track(&mut p, &mut z, &mut tally, al)
+        } else {
+            (0, 0, None)
+        };
         crate::optim::Nlp::values(&mut p, &z, &mut c);
         let sampled_max = p
             .energies()
@@ -183,7 +186,10 @@ impl Planner {
     ) -> Vec<Verified> {
         let model = &self.base.model;
         if starts.len() == 1 {
-            let mut sink = |p: Progress, w: Vec<f64>| observer.progress(model, &p, &w);
+            let mut sink = |p: Progress, w: Vec<f64>| {
+                observer.progress(model, &p, &w);
+                self.poll(observer);
+            };
             let (i, z0) = starts[0].clone();
             let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
             vec![self.refine(i, run, uniform, check, &mut sink)]
@@ -223,6 +229,7 @@ impl Planner {
                 drop(tx);
                 for (p, w) in rx {
                     observer.progress(model, &p, &w);
+                    self.poll(observer);
                 }
                 for h in handles {
                     for (i, r) in h.join().expect("optimiser thread") {

@@ -48,7 +48,7 @@ impl Planner {
         for _ in 0..self.settings.sample_refinements {
             let tunnels = !ver.collision_free(tol);
             let peak = missed_peak(&chosen, &ver);
-            if !tunnels && !peak {
+            if (!tunnels && !peak) || self.stopped() {
                 break;
             }
             let worst_k: Vec<f64> = ver

@@ -13,6 +13,7 @@ use crate::rod::kinematics::Shape;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static_warm};
 use serde::Serialize;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// One replayed shape.
 #[derive(Clone, Debug, Serialize)]
@@ -76,6 +77,28 @@ pub struct Replay {
     pub end_deviation_over_l: f64,
     /// Every step, in increasing `k`.
     pub steps: Vec<ReplayStep>,
+}
+
+impl Replay {
+    /// The replay of a run stopped before it: no step, no verdict (`coincide` false).
+    pub fn not_run(tolerance: f64) -> Replay {
+        Replay {
+            max_deviation_over_l: 0.0,
+            k_at_max_deviation: 0.0,
+            u_max: f64::NAN,
+            all_stable: false,
+            all_converged: false,
+            min_clearance: None,
+            max_contact_force: 0.0,
+            k_at_max_contact_force: 0.0,
+            snaps: Vec::new(),
+            tolerance,
+            coincide: false,
+            start_deviation_over_l: 0.0,
+            end_deviation_over_l: 0.0,
+            steps: Vec::new(),
+        }
+    }
 }
 
 /// Replay settings.
@@ -158,6 +181,7 @@ pub fn replay(
     opts: ReplayOptions,
     static_opts: &StaticOptions,
     observer: &mut dyn PlanObserver,
+    stop: &AtomicBool,
 ) -> Replay {
     let model = &base.model;
     let l = model.rod.length;
@@ -247,7 +271,15 @@ pub fn replay(
     };
     let mut current = solve(0.0, &seed, &first_target);
     record(&current, &first_target, &mut steps, observer);
+    let mut interrupted = false;
     for i in 1..=opts.steps {
+        if observer.stop_requested() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
         let k_hi = i as f64 / opts.steps as f64;
         // Advance from current.k to k_hi, bisecting where the replayed shape jumps.
         let mut pending = vec![(k_hi, 0usize)];
@@ -295,7 +327,7 @@ pub fn replay(
         min_clearance: steps.iter().filter_map(|s| s.clearance).reduce(f64::min),
         max_contact_force: fmax,
         k_at_max_contact_force: steps[icf].k,
-        coincide: max_dev <= opts.tolerance && all_converged && snaps.is_empty(),
+        coincide: !interrupted && max_dev <= opts.tolerance && all_converged && snaps.is_empty(),
         snaps,
         tolerance: opts.tolerance,
         start_deviation_over_l: steps[0].deviation / l,

@@ -16,6 +16,9 @@ pub enum PlanStatus {
     Collision,
     /// The optimiser did not converge (the path may still be collision-free).
     NotConverged,
+    /// The run was stopped ([`super::Planner::stop_handle`]): the plan is the best found so
+    /// far, verified; the replay did not run or did not finish.
+    Interrupted,
 }
 
 impl std::fmt::Display for PlanStatus {
@@ -24,6 +27,7 @@ impl std::fmt::Display for PlanStatus {
             PlanStatus::Planned => "planned",
             PlanStatus::Collision => "collision",
             PlanStatus::NotConverged => "not converged",
+            PlanStatus::Interrupted => "interrupted",
         })
     }
 }
@@ -49,6 +53,8 @@ pub enum PlanVerdict {
     SelfCollision,
     /// The path optimiser did not converge.
     NotConverged,
+    /// The run was stopped before it finished.
+    Interrupted,
 }
 
 impl PlanVerdict {
@@ -67,6 +73,7 @@ impl std::fmt::Display for PlanVerdict {
             PlanVerdict::ObstacleCollision => "collision with an obstacle",
             PlanVerdict::SelfCollision => "the rod crosses itself",
             PlanVerdict::NotConverged => "the path optimiser did not converge",
+            PlanVerdict::Interrupted => "interrupted",
         })
     }
 }
@@ -157,6 +164,7 @@ impl PlanResult {
     /// The verdict: executable, or why not.
     pub fn verdict(&self) -> PlanVerdict {
         match self.status {
+            PlanStatus::Interrupted => PlanVerdict::Interrupted,
             PlanStatus::Collision if self.min_clearance.is_none_or(|c| c >= 0.0) => {
                 PlanVerdict::SelfCollision
             }

@@ -107,6 +107,9 @@ impl Planner {
                     plan,
                 }));
                 // Checked before the next group, and before the next fallback planner is made.
+                if self.stopped() {
+                    break 'attempts;
+                }
                 if runs
                     .iter()
                     .any(|r| self.class(&r.plan) == (true, true, true))

@@ -60,6 +60,9 @@ impl Planner {
             )
         };
         for _ in 0..self.settings.equilibrium_rounds {
+            if self.stopped() {
+                break;
+            }
             let targets = equilibria(p, z);
             let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
                 old.iter()
@@ -100,7 +103,9 @@ impl Planner {
                 ..al
             };
             let out =
-                augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_, _| {});
+                augmented_lagrangian_observed(p, z, tally.lambda.as_deref(), al_t, &mut |_, _| {
+                    !self.stopped()
+                });
             if tally.absorb(out) {
                 failed = true;
                 break;

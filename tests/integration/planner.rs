@@ -1372,3 +1372,67 @@ fn verification_finds_tunnelling_between_its_grid_values() {
     assert!(cs <= cf + 1e-12, "two grid values find {cs}, 201 find {cf}");
     assert!(!sparse.collision_free(1e-6));
 }
+
+/// An observer that asks the run to stop at its third progress report, and counts what it
+/// hears after that.
+#[derive(Default)]
+struct StopAtThird {
+    progress: usize,
+    after_stop: usize,
+    replay_shapes: usize,
+    in_replay: bool,
+}
+
+impl dlo_planner::planner::observer::PlanObserver for StopAtThird {
+    fn phase(&mut self, name: &str) {
+        self.in_replay = name == "replay";
+    }
+    fn shape(
+        &mut self,
+        _m: &dlo_planner::rod::model::Model,
+        _r: &dlo_planner::planner::observer::ShapeRecord,
+    ) {
+        if self.in_replay {
+            self.replay_shapes += 1;
+        }
+    }
+    fn progress(
+        &mut self,
+        _m: &dlo_planner::rod::model::Model,
+        _p: &dlo_planner::planner::observer::Progress,
+        _w: &[f64],
+    ) {
+        self.progress += 1;
+        if self.progress > 3 {
+            self.after_stop += 1;
+        }
+    }
+    fn stop_requested(&mut self) -> bool {
+        self.progress >= 3
+    }
+}
+
+/// An observer stops a plan: the optimiser stops at the iteration it is asked at, nothing is
+/// replayed, and the result says `interrupted` (the CLI's Ctrl-C goes this way).
+#[test]
+fn an_observer_stops_a_plan_and_the_result_says_interrupted() {
+    let c = case::load(Path::new("planning_cases/plan_paper_planar.json")).unwrap();
+    let planner = Planner::from_case(&c).unwrap();
+    let mut obs = StopAtThird::default();
+    let r = planner.run(&mut obs);
+    assert_eq!(r.status, PlanStatus::Interrupted);
+    assert_eq!(r.verdict(), dlo_planner::planner::PlanVerdict::Interrupted);
+    assert_eq!(r.optimiser, dlo_planner::optim::AlStatus::Interrupted);
+    assert_eq!(obs.progress, 3, "no outer iteration after the stop");
+    assert_eq!(obs.after_stop, 0);
+    assert_eq!(obs.replay_shapes, 0, "the replay does not run");
+    assert!(r.replay.steps.is_empty() && !r.replay.coincide);
+    // The plan so far is still verified on the grid.
+    assert!(r.u_max.is_finite() && r.u_max > 0.0);
+    // The flag can be set from outside too: a planner whose handle is set stops at once.
+    let p2 = Planner::from_case(&c).unwrap();
+    p2.stop_handle()
+        .store(true, std::sync::atomic::Ordering::SeqCst);
+    let r2 = p2.run(&mut Silent);
+    assert_eq!(r2.status, PlanStatus::Interrupted);
+}

@@ -7,6 +7,15 @@ use super::*;
 /// (and SIGTERM) handler.
 pub(crate) static ACTIVE_LOG: OnceLock<(SharedWriter, PathBuf)> = OnceLock::new();
 
+/// Set while a plan runs: the first Ctrl-C (or SIGTERM) then asks the planner to stop
+/// ([`STOP`]) instead of ending the process, so that the run ends as `interrupted` and
+/// finishes its log on its own; a second one ends it at once.
+pub(crate) static COOPERATIVE: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Set by the first Ctrl-C of a plan; the plan's observer reads it.
+pub(crate) static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// Where the log bound for `path` is written until it is finished: a name of this process's own
 /// beside it, so that a run killed hard leaves the previous run's finished log whole (and its
 /// own finished chunks, for `dlo recover`), and two runs at once never write one file.
@@ -34,6 +43,10 @@ pub(crate) fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf)
     let shared: SharedWriter = Arc::new(Mutex::new(w));
     if ACTIVE_LOG.set((shared.clone(), path.clone())).is_ok() {
         let _ = ctrlc::set_handler(|| {
+            use std::sync::atomic::Ordering::SeqCst;
+            if COOPERATIVE.load(SeqCst) && !STOP.swap(true, SeqCst) {
+                return;
+            }
             if let Some((w, path)) = ACTIVE_LOG.get() {
                 let mut w = dlo_planner::output::mcap_log::lock(w);
                 if w.finish().is_ok() {

@@ -10,6 +10,9 @@ pub(crate) struct CliObserver {
 }
 
 impl PlanObserver for CliObserver {
+    fn stop_requested(&mut self) -> bool {
+        STOP.load(std::sync::atomic::Ordering::SeqCst)
+    }
     fn begin(&mut self, model: &dlo_planner::rod::model::Model) {
         self.log.begin(model);
     }
@@ -105,6 +108,7 @@ pub(crate) fn run_plan(
         tty: std::io::stderr().is_terminal(),
         started: Instant::now(),
     };
+    COOPERATIVE.store(true, std::sync::atomic::Ordering::SeqCst);
     let mut result = planner.run(&mut obs);
     result.timing_s.endpoints = t_end;
     if let Some([v, w]) = speeds {
@@ -124,6 +128,10 @@ pub(crate) fn run_plan(
     }
     if let Err(code) = close_log(&log, &log_path) {
         return code;
+    }
+    if result.verdict() == PlanVerdict::Interrupted {
+        eprintln!("interrupted: the log was finished and is readable");
+        return ExitCode::from(EXIT_INTERRUPTED as u8);
     }
     let csv_path = log_dir.join(format!("{}.trajectory.csv", c.name));
     if let Err(code) = write_atomically(&csv_path, &result.trajectory.to_csv()) {
@@ -216,6 +224,7 @@ pub(crate) fn run_plan(
             ExitCode::from(EXIT_NOT_COINCIDENT)
         }
         PlanVerdict::Executable => ExitCode::SUCCESS,
+        PlanVerdict::Interrupted => ExitCode::from(EXIT_INTERRUPTED as u8),
     }
 }
 
