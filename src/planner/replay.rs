@@ -173,6 +173,7 @@ pub(crate) fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 
 /// Replays `path(z)` from `start`, the static solve of its start shape (an equilibrium of
 /// `base` plus the start pose, whose multipliers warm-start the first step).
+#[allow(clippy::too_many_arguments)]
 pub fn replay(
     base: &StaticProblem,
     start: &StaticSolution,
