@@ -8,7 +8,7 @@ use dlo_planner::case;
 use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter};
 use dlo_planner::planner::Planner;
 use dlo_planner::planner::observer::Silent;
-use dlo_planner::planner::replay::{ReplayOptions, replay};
+use dlo_planner::planner::replay::replay;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
@@ -43,11 +43,7 @@ fn benches(c: &mut Criterion) {
     });
     let r = pl.run(&mut Silent);
     let path = pl.with_terms(r.path_terms).path();
-    let opts = ReplayOptions {
-        steps: pl.settings.replay_steps,
-        refinements: pl.settings.replay_refinements,
-        tolerance: pl.settings.coincide_tolerance,
-    };
+    let opts = pl.settings.replay();
     g.bench_function("replay (41 steps)", |b| {
         b.iter(|| {
             replay(

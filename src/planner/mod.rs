@@ -8,13 +8,12 @@ mod clear_samples;
 pub mod endpoints;
 pub mod minimax;
 pub mod observer;
-mod optimise;
 pub mod orientation;
 pub mod path;
-mod refine;
 pub mod replay;
 pub mod result;
 pub mod settings;
+mod start;
 mod starts;
 pub mod swept;
 mod tracking;
@@ -33,13 +32,13 @@ pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, ShapeRecord};
-use replay::{Replay, ReplayOptions, replay};
+use replay::{Replay, replay};
 pub use settings::{Optimiser, PlanSettings};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
-use refine::Verified;
+use start::Verified;
 pub use result::{PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
 
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
@@ -591,11 +590,7 @@ impl Planner {
                 &self.start,
                 &path,
                 &chosen.z,
-                ReplayOptions {
-                    steps: self.settings.replay_steps,
-                    refinements: self.settings.replay_refinements,
-                    tolerance: self.settings.coincide_tolerance,
-                },
+                self.settings.replay(),
                 &self.static_options,
                 observer,
                 &self.stop,

@@ -1,6 +1,7 @@
 //! The settings of a plan: one struct, with the case file's names (the `plan` section's keys
 //! other than `start` and `goal`), defaults and validation. [`super::Planner::new`] takes it.
 
+use super::replay::ReplayOptions;
 use serde::{Deserialize, Serialize};
 
 /// How a plan is computed: the path's form, the optimiser's samples and continuation, the
@@ -215,6 +216,15 @@ impl PlanSettings {
     /// `L/100` when it is not set.
     pub fn safety(&self, length: f64) -> f64 {
         self.safety_margin.unwrap_or(length / 100.0) / length
+    }
+
+    /// The replay's settings: `replay_steps`, `replay_refinements`, `coincide_tolerance`.
+    pub fn replay(&self) -> ReplayOptions {
+        ReplayOptions {
+            steps: self.replay_steps,
+            refinements: self.replay_refinements,
+            tolerance: self.coincide_tolerance,
+        }
     }
 
     /// Starts run side by side: `parallel_starts`, or all of them.

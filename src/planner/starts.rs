@@ -4,9 +4,8 @@
 //! the plan.
 
 use super::Planner;
-use super::observer::PlanObserver;
-use super::optimise::noise;
-use super::refine::Verified;
+use super::observer::{PlanObserver, Progress};
+use super::start::Verified;
 use super::verify::{Verification, verify_with};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
@@ -22,6 +21,44 @@ pub(super) struct StartPlan {
     pub(super) terms: usize,
     /// The plan, verified and refined.
     pub(super) plan: Verified,
+}
+
+/// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
+fn noise(seed: u64, n: usize) -> Vec<f64> {
+    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            let v = s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+            2.0 * (v as f64 / (1u64 << 53) as f64) - 1.0
+        })
+        .collect()
+}
+
+/// Largest violation of the optimiser's sampled constraints (dimensionless) for which a plan
+/// counts as feasible on its samples.
+const FEASIBLE_ON_SAMPLES: f64 = 1e-6;
+
+/// The order in which plans are preferred before their `U_max`: collision-free on the
+/// verification grid first, then feasible on the optimiser's samples, then estimated to
+/// coincide with their replay (fields compared in that order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) struct PlanClass {
+    /// Clear of every obstacle and of itself on the verification grid.
+    pub(super) collision_free: bool,
+    /// The optimiser's sampled constraints hold.
+    pub(super) feasible: bool,
+    /// The sampled shapes lie within the coincidence tolerance of their equilibria.
+    pub(super) coincides: bool,
+}
+
+impl PlanClass {
+    /// All three: no later start or fallback can do better before `U_max`.
+    pub(super) fn is_best(self) -> bool {
+        self.collision_free && self.feasible && self.coincides
+    }
 }
 
 impl Planner {
@@ -51,17 +88,16 @@ impl Planner {
         )
     }
 
-    /// Whether plan `r` is collision-free ([`Planner::collision_tolerance`]), feasible on its
-    /// samples, and estimated to coincide with its replay: the order in which plans are
-    /// preferred, before `U_max`.
-    pub(super) fn class(&self, r: &Verified) -> (bool, bool, bool) {
-        (
-            r.verification.collision_free(self.collision_tolerance()),
-            r.run.violation <= 1e-6,
-            r.run
+    /// How good plan `r` is before its `U_max` counts ([`PlanClass`]).
+    pub(super) fn class(&self, r: &Verified) -> PlanClass {
+        PlanClass {
+            collision_free: r.verification.collision_free(self.collision_tolerance()),
+            feasible: r.run.violation <= FEASIBLE_ON_SAMPLES,
+            coincides: r
+                .run
                 .equilibrium_deviation
                 .is_some_and(|d| d <= self.settings.coincide_tolerance),
-        )
+        }
     }
 
     /// Runs the starts in groups and the fallback path-term counts (see the module's doc),
@@ -112,12 +148,85 @@ impl Planner {
                 }
                 if runs
                     .iter()
-                    .any(|r| self.class(&r.plan) == (true, true, true))
+                    .any(|r| self.class(&r.plan).is_best())
                 {
                     break 'attempts;
                 }
             }
         }
         runs
+    }
+}
+
+impl Planner {
+    /// Optimises from each of `starts` (start index and perturbation of the straight-line path)
+    /// on the samples `uniform`, then verifies and refines each plan with `check`
+    /// ([`Planner::refine`]), on parallel threads when there are several starts, telling
+    /// `observer` their progress as it happens.
+    pub(super) fn optimise_starts(
+        &self,
+        starts: &[(usize, Vec<f64>)],
+        uniform: &[f64],
+        check: &(dyn Fn(&[f64]) -> Verification + Sync),
+        observer: &mut dyn PlanObserver,
+    ) -> Vec<Verified> {
+        let model = &self.base.model;
+        if starts.len() == 1 {
+            let mut sink = |p: Progress, w: Vec<f64>| {
+                observer.progress(model, &p, &w);
+                self.poll(observer);
+            };
+            let (i, z0) = starts[0].clone();
+            let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
+            vec![self.refine(i, run, uniform, check, &mut sink)]
+        } else {
+            let workers = std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(starts.len());
+            let mut results: Vec<Option<Verified>> = (0..starts.len()).map(|_| None).collect();
+            // The starts report their progress through a channel, which this thread passes on
+            // to the observer while they run.
+            let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
+            std::thread::scope(|sc| {
+                let chunks: Vec<Vec<usize>> = (0..workers)
+                    .map(|w| (w..starts.len()).step_by(workers).collect())
+                    .collect();
+                let handles: Vec<_> = chunks
+                    .into_iter()
+                    .map(|idx| {
+                        let starts = &starts;
+                        let uniform = &uniform;
+                        let tx = tx.clone();
+                        sc.spawn(move || {
+                            let mut sink = |p: Progress, w: Vec<f64>| {
+                                // The receiver outlives every start.
+                                let _ = tx.send((p, w));
+                            };
+                            idx.into_iter()
+                                .map(|j| {
+                                    let (i, z0) = starts[j].clone();
+                                    let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
+                                    (j, self.refine(i, run, uniform, check, &mut sink))
+                                })
+                                .collect::<Vec<_>>()
+                        })
+                    })
+                    .collect();
+                drop(tx);
+                for (p, w) in rx {
+                    observer.progress(model, &p, &w);
+                    self.poll(observer);
+                }
+                for h in handles {
+                    for (i, r) in h.join().expect("optimiser thread") {
+                        results[i] = Some(r);
+                    }
+                }
+            });
+            results
+                .into_iter()
+                .map(|r| r.expect("every start ran"))
+                .collect()
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! term in the objective, re-optimising, round after round while it helps (see the README).
 
 use super::minimax::MinimaxProblem;
-use super::optimise::Tally;
+use super::start::Tally;
 use super::{Planner, replay};
 use crate::constraints::Constraint;
 use crate::optim::{AlOptions, augmented_lagrangian_observed};

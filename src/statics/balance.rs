@@ -16,7 +16,7 @@
 
 use crate::rod::kinematics::{Shape, cross};
 use crate::statics::problem::StaticProblem;
-use crate::statics::{Reaction, point_forces};
+use crate::statics::reactions::{Reaction, point_forces};
 use serde::Serialize;
 
 /// The total force and moment on the rod (moments about its base point `x(0)`), in case units.

@@ -172,28 +172,18 @@ pub(crate) fn run_plan(
             ExitCode::from(EXIT_COLLISION)
         }
         PlanVerdict::ObstacleCollision => {
+            let worst = result
+                .verification
+                .obstacles
+                .iter()
+                .min_by(|a, b| a.clearance.total_cmp(&b.clearance));
             eprintln!(
                 "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}); {}",
                 path.display(),
                 result.min_clearance.unwrap_or(0.0),
-                result
-                    .verification
-                    .obstacles
-                    .iter()
-                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
-                    .map_or("?", |o| o.obstacle.as_str()),
-                result
-                    .verification
-                    .obstacles
-                    .iter()
-                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
-                    .map_or(0.0, |o| o.k),
-                result
-                    .verification
-                    .obstacles
-                    .iter()
-                    .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
-                    .map_or(0.0, |o| o.s),
+                worst.map_or("?", |o| o.obstacle.as_str()),
+                worst.map_or(0.0, |o| o.k),
+                worst.map_or(0.0, |o| o.s),
                 TRY_COLLISION
             );
             ExitCode::from(EXIT_COLLISION)

@@ -1,25 +1,14 @@
-//! The path optimisation of one start (the sharpness continuation, then equilibrium tracking),
-//! and several starts on parallel threads.
+//! One start's pipeline: the path optimisation from a perturbed straight-line path (the
+//! sharpness continuation, then equilibrium tracking, [`super::tracking`]), and the plan's
+//! verification and sample refinement: where the verification grid finds tunnelling, or an
+//! energy peak the optimiser's samples missed, the grid's worst `k` (and its neighbours) join
+//! the samples and the sharpest stage runs again from the current path. Every start refines
+//! its own plan, so that the starts compete on verified paths.
 
-use super::observer::{PlanObserver, Progress};
-use super::refine::Verified;
+use super::observer::Progress;
 use super::verify::Verification;
 use super::{Planner, settings};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
-
-/// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
-pub(super) fn noise(seed: u64, n: usize) -> Vec<f64> {
-    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    (0..n)
-        .map(|_| {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            let v = s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
-            2.0 * (v as f64 / (1u64 << 53) as f64) - 1.0
-        })
-        .collect()
-}
 
 /// What the multiplier-method calls of one start have produced so far.
 #[derive(Clone)]
@@ -172,75 +161,105 @@ impl Planner {
             equilibrium_deviation,
         }
     }
+}
 
-    /// Optimises from each of `starts` (start index and perturbation of the straight-line path)
-    /// on the samples `uniform`, then verifies and refines each plan with `check`
-    /// ([`Planner::refine`]), on parallel threads when there are several starts, telling
-    /// `observer` their progress as it happens.
-    pub(super) fn optimise_starts(
+/// One start's plan after its verification and sample refinement.
+#[derive(Clone)]
+pub(super) struct Verified {
+    /// The optimiser's outcome (evaluations include the refinement rounds').
+    pub(super) run: StartRun,
+    /// The plan on the verification grid.
+    pub(super) verification: Verification,
+    /// Samples of `k` added by the refinement rounds.
+    pub(super) added: Vec<f64>,
+}
+
+impl Planner {
+    /// Verifies start `start`'s plan `run` (optimised on the samples `uniform`) with `check`
+    /// and refines its samples while the grid finds tunnelling or a missed peak, keeping the
+    /// best verified path (collision-free first, then the lower true U_max).
+    pub(super) fn refine(
         &self,
-        starts: &[(usize, Vec<f64>)],
+        start: usize,
+        run: StartRun,
         uniform: &[f64],
         check: &(dyn Fn(&[f64]) -> Verification + Sync),
-        observer: &mut dyn PlanObserver,
-    ) -> Vec<Verified> {
-        let model = &self.base.model;
-        if starts.len() == 1 {
-            let mut sink = |p: Progress, w: Vec<f64>| {
-                observer.progress(model, &p, &w);
-                self.poll(observer);
-            };
-            let (i, z0) = starts[0].clone();
-            let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
-            vec![self.refine(i, run, uniform, check, &mut sink)]
-        } else {
-            let workers = std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(starts.len());
-            let mut results: Vec<Option<Verified>> = (0..starts.len()).map(|_| None).collect();
-            // The starts report their progress through a channel, which this thread passes on
-            // to the observer while they run.
-            let (tx, rx) = std::sync::mpsc::channel::<(Progress, Vec<f64>)>();
-            std::thread::scope(|sc| {
-                let chunks: Vec<Vec<usize>> = (0..workers)
-                    .map(|w| (w..starts.len()).step_by(workers).collect())
-                    .collect();
-                let handles: Vec<_> = chunks
-                    .into_iter()
-                    .map(|idx| {
-                        let starts = &starts;
-                        let uniform = &uniform;
-                        let tx = tx.clone();
-                        sc.spawn(move || {
-                            let mut sink = |p: Progress, w: Vec<f64>| {
-                                // The receiver outlives every start.
-                                let _ = tx.send((p, w));
-                            };
-                            idx.into_iter()
-                                .map(|j| {
-                                    let (i, z0) = starts[j].clone();
-                                    let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
-                                    (j, self.refine(i, run, uniform, check, &mut sink))
-                                })
-                                .collect::<Vec<_>>()
-                        })
-                    })
-                    .collect();
-                drop(tx);
-                for (p, w) in rx {
-                    observer.progress(model, &p, &w);
-                    self.poll(observer);
+        sink: &mut dyn FnMut(Progress, Vec<f64>),
+    ) -> Verified {
+        let tol = self.collision_tolerance();
+        let h = 1.0 / (self.settings.verify_k_samples - 1) as f64;
+        let gap = self.settings.energy_gap_tolerance;
+        let missed_peak = |r: &StartRun, v: &Verification| {
+            v.u_max - r.sampled_max > gap * r.sampled_max.abs().max(v.u_max.abs())
+        };
+        let better = |a: &Verification, b: &Verification| {
+            (a.collision_free(tol), -a.u_max) > (b.collision_free(tol), -b.u_max)
+        };
+        let mut chosen = run;
+        let mut ver = check(&chosen.z);
+        let mut ks = uniform.to_vec();
+        let mut added = Vec::new();
+        let mut kept: Option<(StartRun, Verification)> = None;
+        for _ in 0..self.settings.sample_refinements {
+            let tunnels = !ver.collision_free(tol);
+            let peak = missed_peak(&chosen, &ver);
+            if (!tunnels && !peak) || self.stopped() {
+                break;
+            }
+            let worst_k: Vec<f64> = ver
+                .obstacles
+                .iter()
+                .filter(|o| o.clearance < -tol)
+                .map(|o| o.k)
+                .chain(ver.self_contact.filter(|(g, _)| *g < -tol).map(|(_, k)| k))
+                .chain(peak.then_some(ver.k_at_u_max))
+                .collect();
+            for kw in worst_k {
+                // The grid's worst k and its grid neighbours, and the midpoints of the
+                // optimiser's interval holding it and of the intervals on either side: the
+                // sample spacing halves where the path tunnels or peaks.
+                let mut cand = vec![kw - h, kw, kw + h];
+                let i = ks
+                    .iter()
+                    .rposition(|&q| q <= kw)
+                    .unwrap_or(0)
+                    .min(ks.len() - 2);
+                for j in i.saturating_sub(1)..(i + 2).min(ks.len() - 1) {
+                    cand.push(0.5 * (ks[j] + ks[j + 1]));
                 }
-                for h in handles {
-                    for (i, r) in h.join().expect("optimiser thread") {
-                        results[i] = Some(r);
+                for k in cand {
+                    if k > 0.0 && k < 1.0 && !ks.iter().any(|&q| (q - k).abs() < 0.25 * h) {
+                        ks.push(k);
+                        added.push(k);
                     }
                 }
-            });
-            results
-                .into_iter()
-                .map(|r| r.expect("every start ran"))
-                .collect()
+            }
+            ks.sort_by(f64::total_cmp);
+            if kept.as_ref().is_none_or(|(_, kv)| better(&ver, kv)) {
+                kept = Some((chosen.clone(), ver.clone()));
+            }
+            // Warm: only the sharpest stage again.
+            let last = self.settings.sharpness.len() - 1;
+            let r = self.optimise_from(start, chosen.z.clone(), &ks, last, sink);
+            chosen = StartRun {
+                evaluations: chosen.evaluations + r.evaluations,
+                ..r
+            };
+            ver = check(&chosen.z);
+        }
+        if let Some((kr, kv)) = kept
+            && better(&kv, &ver)
+        {
+            chosen = StartRun {
+                evaluations: chosen.evaluations,
+                ..kr
+            };
+            ver = kv;
+        }
+        Verified {
+            run: chosen,
+            verification: ver,
+            added,
         }
     }
 }
