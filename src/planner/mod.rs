@@ -38,8 +38,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
-use start::Verified;
 pub use result::{PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
+use start::Verified;
 
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
 /// obstacles and self-contact), where its controlled end starts and where it goes.

@@ -146,10 +146,7 @@ impl Planner {
                 if self.stopped() {
                     break 'attempts;
                 }
-                if runs
-                    .iter()
-                    .any(|r| self.class(&r.plan).is_best())
-                {
+                if runs.iter().any(|r| self.class(&r.plan).is_best()) {
                     break 'attempts;
                 }
             }

@@ -3,7 +3,7 @@
 //! Everything that acts on the rod from outside — supports (position, relative-position and
 //! orientation constraints, the fixed base), obstacle contacts, point loads and gravity — must
 //! have zero total force and moment. A fixed base's force is defined to close the force balance
-//! ([`crate::statics::reactions`]), so there the moment is what tests the reactions; with a
+//! ([`crate::statics::reactions()`]), so there the moment is what tests the reactions; with a
 //! free base the force balance is a test too. Self-contact
 //! forces come in equal, opposite and collinear pairs and cancel; they are left out.
 //!
@@ -38,7 +38,7 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 /// The balance of the shape `a` (evaluated: `shape`) with multipliers `lambda` and its
-/// `reactions` ([`crate::statics::reactions`]).
+/// `reactions` ([`crate::statics::reactions()`]).
 pub fn balance(
     p: &StaticProblem,
     a: &[f64],

@@ -13,7 +13,6 @@ pub mod stability;
 
 pub use builder::{BuildError, StaticProblemBuilder};
 pub use problem::StaticProblem;
-pub use settings::StaticSettings;
 pub use reactions::{Reaction, SelfContactForce, reactions, self_contacts};
-pub(crate) use reactions::point_forces;
+pub use settings::StaticSettings;
 pub use solve::*;

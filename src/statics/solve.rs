@@ -1,14 +1,10 @@
 //! The static solve: the multiplier method on a [`StaticProblem`], its multipliers turned into
 //! reactions ([`super::reactions`]), the moment balance and a stability verdict.
 
-use crate::constraints::Angle;
 use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
 use crate::rod::energy::EnergyTerms;
-use crate::rod::kinematics::{Shape, rotation};
-use crate::rod::layout::Field;
 use crate::statics::problem::StaticProblem;
 use crate::statics::reactions::{Reaction, SelfContactForce, reactions, self_contacts};
-use serde::Serialize;
 
 /// How a static solve ended.
 pub type SolveStatus = AlStatus;
