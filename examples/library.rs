@@ -88,14 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let start = End::pose(&held, [0.5, 0.0, 0.6], about_y(FRAC_PI_2));
     let goal = End::pose(&held, [-0.5, 0.0, 0.6], about_y(-FRAC_PI_2));
-    // The defaults, with fallbacks: where no plan with the default 3 path terms coincides
-    // with its replay, the planner tries again with 6 and then 8 (with 3 alone, this plan's
-    // replay departs by 2.2 % of L).
-    let settings = PlanSettings {
-        fallback_path_terms: vec![6, 8],
-        ..PlanSettings::default()
-    };
-    let planner = Planner::new(PlanProblem::new(held, start, goal), settings)?;
+    let planner = Planner::new(PlanProblem::new(held, start, goal), PlanSettings::default())?;
     let plan = planner.run(&mut Silent);
     println!(
         "plan: {}, U_max {:.4} (straight path {:.4}), clearance {:.4} (straight path {:.4}), replay {} (largest deviation {:.2e} L)",

@@ -112,9 +112,12 @@ impl Planner {
         let starts = self.settings.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
         // The case's planner, then one per fallback count, made only when it is reached.
-        let fallbacks = self.settings.fallback_path_terms.iter();
-        let attempts = std::iter::once(Cow::Borrowed(self))
-            .chain(fallbacks.map(|&t| Cow::Owned(self.with_terms(t))));
+        let fallbacks = self.settings.fallback_terms(self.base.model.layout.spatial);
+        let attempts = std::iter::once(Cow::Borrowed(self)).chain(
+            fallbacks
+                .into_iter()
+                .map(|t| Cow::Owned(self.with_terms(t))),
+        );
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();

@@ -590,7 +590,7 @@ fn plan_prints_documented_json_and_exit_codes() {
   "plan": {
     "start": { "x": 0.0, "z": 0.8, "theta": 0.0, "shape": { "theta": [0, 0, 1.2, 0, 0, 0, 0, 0, 0, 0] } },
     "goal": { "x": 0.0, "z": 0.8, "theta": 0.8, "shape": { "theta": [0, 0, -1.2, 0, 0, 0, 0, 0, 0, 0] } },
-    "k_samples": 21 } }"#,
+    "k_samples": 21, "fallback_path_terms": [] } }"#,
     )
     .unwrap();
     let (code, out, err) = plan_json(snap.to_str().unwrap());

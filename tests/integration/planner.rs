@@ -596,7 +596,7 @@ fn replay_reports_snap_through() {
     )
     .replace(
         r#""k_samples": 21"#,
-        r#""k_samples": 21, "equilibrium_weight": 1000.0, "equilibrium_rounds": 1"#,
+        r#""k_samples": 21, "equilibrium_weight": 1000.0, "equilibrium_rounds": 1, "fallback_path_terms": []"#,
     );
     let c = case::parse(&text, Path::new("snap.json")).unwrap();
     let p = Planner::from_case(&c).unwrap();
@@ -655,15 +655,16 @@ fn plan_keeps_the_rod_from_crossing_itself() {
     let p = Planner::from_case(&common::spiral_case(true)).unwrap();
     let path = p.path();
     let fine = fine_model(&p.base.model, 256, 4);
-    let gap = |z: &[f64]| {
-        let v = verify_with(&fine, &path, z, 201, &[], p.base.objective, true);
+    let gap = |path: &DeformationPath, z: &[f64]| {
+        let v = verify_with(&fine, path, z, 201, &[], p.base.objective, true);
         v.self_contact.unwrap().0
     };
-    let straight = gap(&vec![0.0; path.n_vars()]);
+    let straight = gap(&path, &vec![0.0; path.n_vars()]);
     assert!(straight < -0.005, "straight-line path: gap {straight}");
     let r = p.run(&mut Silent);
     assert_eq!(r.status, PlanStatus::Planned);
-    let planned = gap(&r.z);
+    // The plan's own path (a fallback's when one was chosen).
+    let planned = gap(&p.with_terms(r.path_terms).path(), &r.z);
     assert!(planned >= 0.0, "plan: gap {planned}");
     assert_eq!(
         r.verification.self_contact.map(|(g, _)| g >= 0.0),
