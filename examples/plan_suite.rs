@@ -36,7 +36,7 @@ const ROTATION_RANGE: f64 = 3.14;
 
 /// splitmix64: a small, fixed pseudo-random sequence (the suite must not depend on a crate's
 /// generator changing).
-struct Rng(u64);
+pub struct Rng(pub u64);
 
 impl Rng {
     fn next(&mut self) -> u64 {
@@ -55,7 +55,7 @@ impl Rng {
     }
 }
 
-fn planar_problem(rng: &mut Rng, i: usize) -> String {
+pub fn planar_problem(rng: &mut Rng, i: usize) -> String {
     let n_obs = 1 + rng.below(3);
     let mut obstacles = Vec::new();
     for j in 0..n_obs {
@@ -109,7 +109,7 @@ fn planar_problem(rng: &mut Rng, i: usize) -> String {
     )
 }
 
-fn spatial_problem(rng: &mut Rng, i: usize) -> String {
+pub fn spatial_problem(rng: &mut Rng, i: usize) -> String {
     let n_obs = 1 + rng.below(2);
     let mut obstacles = Vec::new();
     // The ends' azimuths: the goal on the other side of the z axis.
@@ -185,18 +185,18 @@ fn spatial_problem(rng: &mut Rng, i: usize) -> String {
 }
 
 /// One problem's outcome.
-struct Outcome {
-    name: String,
-    planned: bool,
-    coincide: bool,
-    snaps: bool,
-    seconds: f64,
-    travel: f64,
+pub struct Outcome {
+    pub name: String,
+    pub planned: bool,
+    pub coincide: bool,
+    pub snaps: bool,
+    pub seconds: f64,
+    pub travel: f64,
     /// The independent check's smallest clearance (units of L) and its k, for plans called
     /// collision-free.
-    checked_clearance: Option<(f64, f64)>,
-    u_max: f64,
-    deviation: f64,
+    pub checked_clearance: Option<(f64, f64)>,
+    pub u_max: f64,
+    pub deviation: f64,
 }
 
 /// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
@@ -225,7 +225,7 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
-fn run(
+pub fn run(
     text: &str,
     name: &str,
     plan: &serde_json::Value,

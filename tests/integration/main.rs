@@ -19,5 +19,9 @@ mod paper_claims;
 mod planner;
 mod planner_gradients;
 mod self_contact;
+#[path = "../../examples/plan_suite.rs"]
+#[allow(dead_code)]
+mod suite;
+mod suite_sample;
 mod turned_scenes;
 mod wide_kernels;
