@@ -78,6 +78,145 @@ impl Default for GraspSettings {
     }
 }
 
+/// The most force limits one margin computes (points × directions).
+const MAX_LIMITS: usize = 10_000;
+
+/// The points, unit directions (3D vectors) and friction coefficients of [`GraspSettings`],
+/// defaults filled in.
+struct Resolved {
+    points: Vec<f64>,
+    directions: Vec<[f64; 3]>,
+    mu: Vec<f64>,
+}
+
+impl GraspSettings {
+    /// Checks the settings that do not depend on the grasp's solve for a rod of `length`,
+    /// planar or 3D (`preload` and `f_max` are checked against the solved grasp by
+    /// [`Grasp::new`]).
+    pub fn validate(&self, length: f64, spatial: bool) -> Result<(), GraspSetupError> {
+        self.resolve(length, spatial).map(|_| ())
+    }
+
+    fn resolve(&self, length: f64, spatial: bool) -> Result<Resolved, GraspSetupError> {
+        let err = |f: &str, m: String| GraspSetupError {
+            field: f.to_string(),
+            message: m,
+        };
+        let l = length;
+        let points = self
+            .points
+            .clone()
+            .unwrap_or_else(|| (1..=9).map(|j| l * j as f64 / 10.0).collect());
+        if points.is_empty() {
+            return Err(err("points", "needs at least one point of action".into()));
+        }
+        if points.len() > 10_000 {
+            return Err(err(
+                "points",
+                format!("at most 10000 points, got {}", points.len()),
+            ));
+        }
+        for (i, s) in points.iter().enumerate() {
+            if !(s.is_finite() && *s > 0.0 && *s < l) {
+                return Err(err(
+                    &format!("points[{i}]"),
+                    format!("must be inside (0, {l}), got {s}"),
+                ));
+            }
+        }
+        let directions = match &self.directions {
+            None => even_directions(9),
+            Some(Directions::Count(n)) => {
+                if !(1..=360).contains(n) {
+                    return Err(err(
+                        "directions",
+                        format!("a count must be in 1..=360, got {n}"),
+                    ));
+                }
+                even_directions(*n as usize)
+            }
+            Some(Directions::Vectors(list)) => {
+                if list.len() > 360 {
+                    return Err(err(
+                        "directions",
+                        format!("a list holds at most 360 directions, got {}", list.len()),
+                    ));
+                }
+                let mut out = Vec::new();
+                for (i, d) in list.iter().enumerate() {
+                    let f = format!("directions[{i}]");
+                    let v = d;
+                    let v3 = match (spatial, v.len()) {
+                        (false, 2) => [v[1], 0.0, v[0]],
+                        (true, 3) => [v[0], v[1], v[2]],
+                        _ => {
+                            return Err(err(
+                                &f,
+                                if spatial {
+                                    "give [n_x, n_y, n_z]".into()
+                                } else {
+                                    "give [n_z, n_x] (the paper's order)".into()
+                                },
+                            ));
+                        }
+                    };
+                    // Scaled by its largest component first, so that huge (or tiny) finite
+                    // components do not overflow (or underflow) the norm.
+                    let big = v3.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+                    if !(big.is_finite() && big > 0.0) {
+                        return Err(err(&f, "must be a non-zero finite vector".into()));
+                    }
+                    let v3 = v3.map(|c| c / big);
+                    let norm = (v3[0] * v3[0] + v3[1] * v3[1] + v3[2] * v3[2]).sqrt();
+                    out.push(v3.map(|c| c / norm));
+                }
+                if out.is_empty() {
+                    return Err(err("directions", "needs at least one direction".into()));
+                }
+                out
+            }
+        };
+        // Each (point, direction) pair is a continuation of about 16 solves.
+        if points.len() * directions.len() > MAX_LIMITS {
+            return Err(err(
+                "points",
+                format!(
+                    "{} points × {} directions = {} force limits; at most {MAX_LIMITS}",
+                    points.len(),
+                    directions.len(),
+                    points.len() * directions.len()
+                ),
+            ));
+        }
+        let mu = self
+            .mu
+            .clone()
+            .unwrap_or_else(|| (1..=10).map(|j| j as f64 / 10.0).collect());
+        if mu.is_empty() {
+            return Err(err("mu", "needs at least one friction coefficient".into()));
+        }
+        for (i, m) in mu.iter().enumerate() {
+            if !(m.is_finite() && *m >= 0.0) {
+                return Err(err(
+                    &format!("mu[{i}]"),
+                    format!("must be finite and ≥ 0, got {m}"),
+                ));
+            }
+        }
+        if self.steps == 0 || self.steps > 10_000 {
+            return Err(err(
+                "steps",
+                format!("must be in 1..=10000, got {}", self.steps),
+            ));
+        }
+        Ok(Resolved {
+            points,
+            directions,
+            mu,
+        })
+    }
+}
+
 /// Why a grasp cannot be rated: the field (a key of [`GraspSettings`], or `constraints` for
 /// the grasp itself) and why.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -190,8 +329,6 @@ impl Grasp {
 
     /// Checks `settings` and solves the undisturbed grasp.
     pub fn new(problem: GraspProblem, spec: GraspSettings) -> Result<Grasp, GraspSetupError> {
-        /// The most force limits one margin computes (points × directions).
-        const MAX_LIMITS: usize = 10_000;
         let err = |f: &str, m: String| GraspSetupError {
             field: f.to_string(),
             message: m,
@@ -235,107 +372,12 @@ impl Grasp {
             ));
         }
         let initial_forces = contact_forces(&p, &fingers, &initial.lambda, preload);
-        let points = spec
-            .points
-            .clone()
-            .unwrap_or_else(|| (1..=9).map(|j| l * j as f64 / 10.0).collect());
-        if points.is_empty() {
-            return Err(err("points", "needs at least one point of action".into()));
-        }
-        if points.len() > 10_000 {
-            return Err(err(
-                "points",
-                format!("at most 10000 points, got {}", points.len()),
-            ));
-        }
-        for (i, s) in points.iter().enumerate() {
-            if !(s.is_finite() && *s > 0.0 && *s < l) {
-                return Err(err(
-                    &format!("points[{i}]"),
-                    format!("must be inside (0, {l}), got {s}"),
-                ));
-            }
-        }
         let spatial = base.model.layout.spatial;
-        let directions = match &spec.directions {
-            None => even_directions(9),
-            Some(Directions::Count(n)) => {
-                if !(1..=360).contains(n) {
-                    return Err(err(
-                        "directions",
-                        format!("a count must be in 1..=360, got {n}"),
-                    ));
-                }
-                even_directions(*n as usize)
-            }
-            Some(Directions::Vectors(list)) => {
-                if list.len() > 360 {
-                    return Err(err(
-                        "directions",
-                        format!("a list holds at most 360 directions, got {}", list.len()),
-                    ));
-                }
-                let mut out = Vec::new();
-                for (i, d) in list.iter().enumerate() {
-                    let f = format!("directions[{i}]");
-                    let v = d;
-                    let v3 = match (spatial, v.len()) {
-                        (false, 2) => [v[1], 0.0, v[0]],
-                        (true, 3) => [v[0], v[1], v[2]],
-                        _ => {
-                            return Err(err(
-                                &f,
-                                if spatial {
-                                    "give [n_x, n_y, n_z]".into()
-                                } else {
-                                    "give [n_z, n_x] (the paper's order)".into()
-                                },
-                            ));
-                        }
-                    };
-                    // Scaled by its largest component first, so that huge (or tiny) finite
-                    // components do not overflow (or underflow) the norm.
-                    let big = v3.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
-                    if !(big.is_finite() && big > 0.0) {
-                        return Err(err(&f, "must be a non-zero finite vector".into()));
-                    }
-                    let v3 = v3.map(|c| c / big);
-                    let norm = (v3[0] * v3[0] + v3[1] * v3[1] + v3[2] * v3[2]).sqrt();
-                    out.push(v3.map(|c| c / norm));
-                }
-                if out.is_empty() {
-                    return Err(err("directions", "needs at least one direction".into()));
-                }
-                out
-            }
-        };
-        // Each (point, direction) pair is a continuation of about 16 solves.
-        if points.len() * directions.len() > MAX_LIMITS {
-            return Err(err(
-                "points",
-                format!(
-                    "{} points × {} directions = {} force limits; at most {MAX_LIMITS}",
-                    points.len(),
-                    directions.len(),
-                    points.len() * directions.len()
-                ),
-            ));
-        }
-        let mu = spec
-            .mu
-            .clone()
-            .unwrap_or_else(|| (1..=10).map(|j| j as f64 / 10.0).collect());
-        if mu.is_empty() {
-            return Err(err("mu", "needs at least one friction coefficient".into()));
-        }
-        for (i, m) in mu.iter().enumerate() {
-            if !(m.is_finite() && *m >= 0.0) {
-                return Err(err(
-                    &format!("mu[{i}]"),
-                    format!("must be finite and ≥ 0, got {m}"),
-                ));
-            }
-        }
+        let Resolved {
+            points,
+            directions,
+            mu,
+        } = spec.resolve(l, spatial)?;
         let n0 = initial_forces.iter().map(|c| c.normal).fold(0.0, f64::max);
         let f_max = spec.f_max.unwrap_or(5.0 * n0.max(preload));
         if !(f_max.is_finite() && f_max > 0.0) {
@@ -351,12 +393,6 @@ impl Grasp {
                 format!(
                     "{f_max} is more than 10⁶ times the rod's force scale (Rf/L² = {fu:.3e}, the largest initial contact force {n0:.3e}, the preload {preload:.3e}): at most {f_cap:.3e}"
                 ),
-            ));
-        }
-        if spec.steps == 0 || spec.steps > 10_000 {
-            return Err(err(
-                "steps",
-                format!("must be in 1..=10000, got {}", spec.steps),
             ));
         }
         let static_settings = problem.static_settings.options();

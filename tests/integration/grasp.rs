@@ -218,3 +218,33 @@ fn full_margin_curve_grows_at_every_friction_step() {
         );
     }
 }
+
+/// The grasp settings check what does not need the solved grasp, naming the field.
+#[test]
+fn grasp_settings_name_the_field_they_reject() {
+    use dlo_planner::grasp::{Directions, GraspSettings};
+    let ok = GraspSettings::default();
+    assert_eq!(ok.validate(1.0, false), Ok(()));
+    let field = |s: GraspSettings, spatial: bool| s.validate(1.0, spatial).unwrap_err().field;
+    let mu = GraspSettings {
+        mu: Some(vec![]),
+        ..GraspSettings::default()
+    };
+    assert_eq!(field(mu, false), "mu");
+    let point = GraspSettings {
+        points: Some(vec![0.5, 1.0]),
+        ..GraspSettings::default()
+    };
+    assert_eq!(field(point, false), "points[1]");
+    let planar_vector = GraspSettings {
+        directions: Some(Directions::Vectors(vec![vec![1.0, 0.0, 0.0]])),
+        ..GraspSettings::default()
+    };
+    assert_eq!(field(planar_vector.clone(), false), "directions[0]");
+    assert_eq!(planar_vector.validate(1.0, true), Ok(()));
+    let steps = GraspSettings {
+        steps: 0,
+        ..GraspSettings::default()
+    };
+    assert_eq!(field(steps, true), "steps");
+}
