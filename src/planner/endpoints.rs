@@ -39,12 +39,13 @@ impl End {
 
     /// Fills in the angles of a full orientation, in the branch that continues from
     /// `reference` (the Euler angles of the frame it continues from; see
-    /// [`super::orientation`]). Errors name the problem (a planar rod's end turned about
-    /// another axis than y).
+    /// [`super::orientation`]); a planar tie goes to the branch nearer `held` (the held end's
+    /// angles). Errors name the problem (a planar rod's end turned about another axis than y).
     pub fn resolve(
         &mut self,
         model: &crate::rod::model::Model,
         reference: [f64; 3],
+        held: [f64; 3],
     ) -> Result<(), String> {
         let planar = !model.layout.spatial;
         use crate::rod::layout::Field;
@@ -52,7 +53,7 @@ impl End {
             return Ok(());
         };
         if planar {
-            let theta = super::orientation::planar_branch(r.matrix, reference[1]).ok_or(
+            let theta = super::orientation::planar_branch(r.matrix, reference[1], held[1]).ok_or(
                 "a planar rod's end turns about y only: the orientation is not a rotation about y",
             )?;
             self.angles = vec![(Field::Theta, theta)];

@@ -397,15 +397,15 @@ impl Planner {
         static_options.al.max_step = static_options.al.max_step.min(0.1);
         // Full orientations take the Euler branch that continues from the held end's frame
         // (start) and from the start shape's end (goal).
+        let held = held_frame(&problem.statics);
         let resolve = |end: &mut End, which: &'static str, reference: [f64; 3]| {
-            end.resolve(model, reference)
+            end.resolve(model, reference, held.0)
                 .map_err(|message| PlanSetupError::End {
                     end: which,
                     message,
                 })
         };
         let (mut start_end, mut goal_end) = (problem.start.clone(), problem.goal.clone());
-        let held = held_frame(&problem.statics);
         resolve(&mut start_end, "start", held.0)?;
         let start = end_shape(&problem, "start", &start_end, held, &static_options)?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;

@@ -66,19 +66,32 @@ pub fn euler_branch(m: Matrix, reference: [f64; 3], written_phi: Option<f64>) ->
 }
 
 /// The planar angle `θ` of a rotation about `y` (`m = Ry(θ)`), `2πn` from the one nearest
-/// `reference`; `None` when `m` is not a rotation about `y` (to 1e-6).
-pub fn planar_branch(m: Matrix, reference: f64) -> Option<f64> {
+/// `reference`; `None` when `m` is not a rotation about `y` (to 1e-6). A half-turn either way
+/// from `reference` (a mirror-image goal, within 1e-6 rad) is a tie, which goes to the branch
+/// nearer `held` (the held end's angle): the rod then winds less, and the choice does not hang
+/// on the rounding of `reference`.
+pub fn planar_branch(m: Matrix, reference: f64, held: f64) -> Option<f64> {
     let about_y = (m[1][1] - 1.0).abs() <= 1e-6
         && m[0][1].abs() <= 1e-6
         && m[2][1].abs() <= 1e-6
         && m[1][0].abs() <= 1e-6
         && m[1][2].abs() <= 1e-6;
-    about_y.then(|| nearest(m[0][2].atan2(m[2][2]), reference))
+    about_y.then(|| {
+        let theta = nearest(m[0][2].atan2(m[2][2]), reference);
+        let d = theta - reference;
+        let other = theta - TAU * d.signum();
+        if (d.abs() - PI).abs() <= 1e-6 && (other - held).abs() < (theta - held).abs() {
+            other
+        } else {
+            theta
+        }
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     fn same(a: Matrix, b: Matrix) -> bool {
         (0..3).all(|i| (0..3).all(|j| (a[i][j] - b[i][j]).abs() < 1e-12))
@@ -131,7 +144,17 @@ mod tests {
     #[test]
     fn planar_rotation_is_about_y() {
         let m = rotation(0.0, 0.5, 0.0);
-        assert!((planar_branch(m, 6.0).unwrap() - (0.5 + TAU)).abs() < 1e-12);
-        assert!(planar_branch(rotation(0.3, 0.5, 0.0), 0.0).is_none());
+        assert!((planar_branch(m, 6.0, 0.0).unwrap() - (0.5 + TAU)).abs() < 1e-12);
+        assert!(planar_branch(rotation(0.3, 0.5, 0.0), 0.0, 0.0).is_none());
+        // A mirror-image goal, a half-turn either way from the start's π/2 (up to rounding on
+        // either side): the branch nearer the held end's 0, whichever way the rounding went.
+        let down = rotation(0.0, -FRAC_PI_2, 0.0);
+        for eps in [-1e-10, 0.0, 1e-10] {
+            let t = planar_branch(down, FRAC_PI_2 + eps, 0.0).unwrap();
+            assert!((t + FRAC_PI_2).abs() < 1e-12, "{t}");
+        }
+        // Held pointing down (θ(0) = π): the other branch is the one that winds less.
+        let t = planar_branch(down, FRAC_PI_2, PI).unwrap();
+        assert!((t - 3.0 * FRAC_PI_2).abs() < 1e-12, "{t}");
     }
 }
