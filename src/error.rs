@@ -59,3 +59,37 @@ pub struct SettingsError {
     /// What is wrong.
     pub message: String,
 }
+
+impl SettingsError {
+    /// The error for `field`.
+    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
+        SettingsError {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// `x` if it is finite, else the error for `field`.
+    pub fn finite(field: &str, x: f64) -> Result<f64, SettingsError> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(SettingsError::new(
+                field,
+                format!("must be finite, got {x}"),
+            ))
+        }
+    }
+
+    /// `x` if it is finite and positive, else the error for `field`.
+    pub fn positive(field: &str, x: f64) -> Result<f64, SettingsError> {
+        if SettingsError::finite(field, x)? > 0.0 {
+            Ok(x)
+        } else {
+            Err(SettingsError::new(
+                field,
+                format!("must be positive, got {x}"),
+            ))
+        }
+    }
+}

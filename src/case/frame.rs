@@ -29,7 +29,7 @@ use super::plan::{EndSpec, EulerBranch};
 use super::{CaseFile, ConstraintSpec};
 use crate::constraints::Angle;
 use crate::planner::orientation::{Matrix, nearest};
-use crate::rod::kinematics::{angles_of, cross, in_frame, is_rotation, rotation};
+use crate::rod::kinematics::{angles_of, cross, in_frame, is_identity, is_rotation, rotation};
 use crate::rod::layout::Field;
 use std::f64::consts::PI;
 
@@ -433,8 +433,7 @@ fn farthest_on_sphere(lines: &[([f64; 3], f64)]) -> [f64; 3] {
 /// documentation), in the order of `file.constraints`; `None` for one that is not an
 /// orientation.
 pub(crate) fn convert(file: &CaseFile, r: [[f64; 3]; 3]) -> Vec<Option<Vec<(Angle, f64)>>> {
-    let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
-    let frame = (!identity).then_some(r);
+    let frame = (!is_identity(&r)).then_some(r);
     let mut order: Vec<(usize, f64, Written)> = file
         .constraints
         .iter()

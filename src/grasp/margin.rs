@@ -10,6 +10,7 @@
 //! solved on that interpolation (exact where the forces are linear in `f`).
 
 use super::fingers::{ContactForce, Finger, contact_forces, fingers, friction_ratio};
+use crate::error::SettingsError;
 use crate::statics::builder::{BuildError, StaticProblemBuilder};
 use crate::statics::problem::StaticProblem;
 use crate::statics::{
@@ -93,15 +94,12 @@ impl GraspSettings {
     /// Checks the settings that do not depend on the grasp's solve for a rod of `length`,
     /// planar or 3D (`preload` and `f_max` are checked against the solved grasp by
     /// [`Grasp::new`]).
-    pub fn validate(&self, length: f64, spatial: bool) -> Result<(), GraspSetupError> {
+    pub fn validate(&self, length: f64, spatial: bool) -> Result<(), SettingsError> {
         self.resolve(length, spatial).map(|_| ())
     }
 
-    fn resolve(&self, length: f64, spatial: bool) -> Result<Resolved, GraspSetupError> {
-        let err = |f: &str, m: String| GraspSetupError {
-            field: f.to_string(),
-            message: m,
-        };
+    fn resolve(&self, length: f64, spatial: bool) -> Result<Resolved, SettingsError> {
+        let err = |f: &str, m: String| SettingsError::new(f, m);
         let l = length;
         let points = self
             .points
@@ -217,17 +215,6 @@ impl GraspSettings {
     }
 }
 
-/// Why a grasp cannot be rated: the field (a key of [`GraspSettings`], or `constraints` for
-/// the grasp itself) and why.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct GraspSetupError {
-    /// The field, e.g. `preload` or `points[2]`.
-    pub field: String,
-    /// What is wrong.
-    pub message: String,
-}
-
 /// A validated grasp problem with its undisturbed solution.
 #[derive(Clone, Debug)]
 pub struct Grasp {
@@ -327,12 +314,10 @@ impl Grasp {
             .collect()
     }
 
-    /// Checks `settings` and solves the undisturbed grasp.
-    pub fn new(problem: GraspProblem, spec: GraspSettings) -> Result<Grasp, GraspSetupError> {
-        let err = |f: &str, m: String| GraspSetupError {
-            field: f.to_string(),
-            message: m,
-        };
+    /// Checks `spec` and solves the undisturbed grasp. An error names a field of `spec`, or
+    /// `constraints` for the grasp itself (no fingers, no undisturbed equilibrium).
+    pub fn new(problem: GraspProblem, spec: GraspSettings) -> Result<Grasp, SettingsError> {
+        let err = |f: &str, m: String| SettingsError::new(f, m);
         let base = problem
             .statics
             .clone()

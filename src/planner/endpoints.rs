@@ -67,9 +67,7 @@ impl End {
         }
         Ok(())
     }
-}
 
-impl End {
     /// The controlled end at `position` (case units) with orientation `rotation` (row-major,
     /// case axes; on a planar rod a rotation about y), for a rod of `problem`; its Euler branch
     /// is chosen when the plan is set up.

@@ -438,10 +438,7 @@ impl Planner {
 
     /// Asks `observer` whether to stop, and sets the flag if so (on the run's own thread).
     pub(crate) fn poll(&self, observer: &mut dyn PlanObserver) -> bool {
-        if observer.stop_requested() {
-            self.stop.store(true, Ordering::Relaxed);
-        }
-        self.stopped()
+        observer::poll(observer, &self.stop)
     }
 
     /// The optimiser's extra clearance from obstacles in units of `L` (see

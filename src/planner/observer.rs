@@ -5,6 +5,7 @@
 use crate::rod::energy::EnergyTerms;
 use crate::rod::model::Model;
 use crate::statics::Reaction;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Which computation a shape belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -88,3 +89,11 @@ pub trait PlanObserver {
 pub struct Silent;
 
 impl PlanObserver for Silent {}
+
+/// Asks `observer` whether to stop and sets `stop` if so; whether the run is to stop.
+pub(crate) fn poll(observer: &mut dyn PlanObserver, stop: &AtomicBool) -> bool {
+    if observer.stop_requested() {
+        stop.store(true, Ordering::Relaxed);
+    }
+    stop.load(Ordering::Relaxed)
+}

@@ -13,7 +13,7 @@ use crate::rod::kinematics::Shape;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static_warm};
 use serde::Serialize;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 /// One replayed shape.
 #[derive(Clone, Debug, Serialize)]
@@ -274,10 +274,7 @@ pub fn replay(
     record(&current, &first_target, &mut steps, observer);
     let mut interrupted = false;
     for i in 1..=opts.steps {
-        if observer.stop_requested() {
-            stop.store(true, Ordering::Relaxed);
-        }
-        if stop.load(Ordering::Relaxed) {
+        if super::observer::poll(observer, stop) {
             interrupted = true;
             break;
         }

@@ -98,32 +98,15 @@ impl Default for PlanSettings {
 
 use crate::error::SettingsError;
 
+/// The error for `field`.
 fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
-    SettingsError {
-        field: field.into(),
-        message: message.into(),
-    }
+    SettingsError::new(field, message)
 }
 
 impl PlanSettings {
     /// Checks every setting for a rod of `length` (the safety margin is bounded by it).
     pub fn validate(&self, length: f64) -> Result<(), SettingsError> {
-        let finite = |field: &str, x: f64| {
-            if x.is_finite() {
-                Ok(x)
-            } else {
-                Err(bad(field, format!("must be finite, got {x}")))
-            }
-        };
-        let positive = |field: &str, x: f64| {
-            if !x.is_finite() {
-                Err(bad(field, format!("must be finite, got {x}")))
-            } else if x > 0.0 {
-                Ok(x)
-            } else {
-                Err(bad(field, format!("must be positive, got {x}")))
-            }
-        };
+        let (finite, positive) = (SettingsError::finite, SettingsError::positive);
         let l = length;
         let (terms_lo, terms_hi) = PATH_TERMS;
         for (field, val, lo, hi) in [

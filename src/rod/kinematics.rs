@@ -513,6 +513,11 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// Whether `r` is exactly the identity.
+pub(crate) fn is_identity(r: &[[f64; 3]; 3]) -> bool {
+    (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))))
+}
+
 /// `Rᵀ m`: rotation `m` of the case's axes written in frame `r` (row-major); `None` is the
 /// identity, which leaves `m` as it is.
 pub fn in_frame(r: Option<&[[f64; 3]; 3]>, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {

@@ -216,7 +216,7 @@ impl Model {
     /// then describe `Rᵀ` times the case's frames, and the ZYZ pole lies along `R ẑ`. Only a
     /// 3D rod can take one other than the identity; `None` if `R` is refused.
     pub fn with_frame(mut self, r: [[f64; 3]; 3]) -> Option<Model> {
-        let identity = (0..3).all(|i| (0..3).all(|j| r[i][j] == f64::from(u8::from(i == j))));
+        let identity = crate::rod::kinematics::is_identity(&r);
         if !crate::rod::kinematics::is_rotation(r, 1e-12) || !(self.layout.spatial || identity) {
             return None;
         }

@@ -51,37 +51,21 @@ impl Default for StaticSettings {
 impl StaticSettings {
     /// Checks every setting.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let bad = |field: &str, message: String| SettingsError {
-            field: field.into(),
-            message,
-        };
+        let bad = SettingsError::new;
         for (field, v) in [
             ("feasibility_tol", self.feasibility_tol),
             ("optimality_tol", self.optimality_tol),
             ("rho_initial", self.rho_initial),
             ("rho_max", self.rho_max),
         ] {
-            if !v.is_finite() {
-                return Err(bad(field, format!("must be finite, got {v}")));
-            }
-            if v <= 0.0 {
-                return Err(bad(field, format!("must be positive, got {v}")));
-            }
+            SettingsError::positive(field, v)?;
         }
-        if !self.perturbation.is_finite() {
-            return Err(bad(
-                "perturbation",
-                format!("must be finite, got {}", self.perturbation),
-            ));
-        }
+        SettingsError::finite("perturbation", self.perturbation)?;
         if self.rho_max < self.rho_initial {
-            return Err(bad("rho_max", "must be at least solver.rho_initial".into()));
+            return Err(bad("rho_max", "must be at least solver.rho_initial"));
         }
         if self.max_outer == 0 || self.max_inner == 0 {
-            return Err(bad(
-                "max_outer",
-                "iteration budgets must be positive".into(),
-            ));
+            return Err(bad("max_outer", "iteration budgets must be positive"));
         }
         Ok(())
     }
