@@ -22,9 +22,7 @@ use crate::statics::StaticOptions;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{StaticProblemBuilder, StaticSettings};
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::{
-    Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh, TriMeshFlags,
-};
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -922,22 +920,8 @@ fn build_shape(
                     ),
                 }
             })?;
-            let (verts, faces): (Vec<Vector>, _) =
-                (verts.iter().map(|p| vv(*p)).collect(), obj.triangles);
-            let mesh = TriMesh::with_flags(
-                verts,
-                faces,
-                TriMeshFlags::ORIENTED
-                    | TriMeshFlags::MERGE_DUPLICATE_VERTICES
-                    | TriMeshFlags::FIX_INTERNAL_EDGES,
-            )
-            .map_err(|e| {
-                v.err(
-                    format!("{field}.obj"),
-                    format!("{}: invalid mesh: {e:?}", full.display()),
-                )
-            })?;
-            ObstacleShape::TriMesh(Arc::new(mesh))
+            ObstacleShape::checked_triangle_mesh(&verts, obj.triangles)
+                .map_err(|e| v.err(format!("{field}.obj"), format!("{}: {e}", full.display())))?
         }
         ShapeKind::HalfSpace { normal } => {
             let n = v.vec3(&format!("{field}.normal"), *normal)?;

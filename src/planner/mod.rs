@@ -38,7 +38,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
-pub use result::{PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
+pub use result::{PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
 use start::Verified;
 
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
@@ -65,14 +65,7 @@ impl PlanProblem {
     /// A problem from `statics` (the held rod), with its obstacles gathered from its
     /// constraints, the default static settings and the natural start.
     pub fn new(statics: StaticProblem, start: End, goal: End) -> PlanProblem {
-        let obstacles = statics
-            .constraints
-            .iter()
-            .filter_map(|c| match c {
-                Constraint::Obstacle(o) => Some(o.obstacle.clone()),
-                _ => None,
-            })
-            .collect();
+        let obstacles = statics.obstacles();
         let initial = statics.natural_start(0.1);
         PlanProblem {
             statics,

@@ -187,3 +187,45 @@ pub struct Timing {
     /// Replay.
     pub replay: f64,
 }
+
+/// A plan's report: what `dlo plan --json` prints (and the Python package returns), the
+/// result with its verdict, the end shapes' energies and, when the run wrote them, its files.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanReport<'a> {
+    /// Case name.
+    pub case: &'a str,
+    /// Executable, or why not.
+    pub verdict: PlanVerdict,
+    /// The result.
+    #[serde(flatten)]
+    pub result: &'a PlanResult,
+    /// Internal energy of the start shape (case units).
+    pub start_energy: f64,
+    /// Internal energy of the goal shape (case units).
+    pub goal_energy: f64,
+    /// The MCAP log written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mcap: Option<String>,
+    /// Shapes in that log.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log_shapes: Option<u64>,
+    /// The gripper trajectory's CSV file written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trajectory_csv: Option<String>,
+}
+
+impl<'a> PlanReport<'a> {
+    /// The report of `result`, planned by `planner`, without files.
+    pub fn new(case: &'a str, planner: &super::Planner, result: &'a PlanResult) -> Self {
+        PlanReport {
+            case,
+            verdict: result.verdict(),
+            result,
+            start_energy: planner.start.energy.internal(),
+            goal_energy: planner.goal.energy.internal(),
+            mcap: None,
+            log_shapes: None,
+            trajectory_csv: None,
+        }
+    }
+}

@@ -531,7 +531,7 @@ pub fn in_frame(r: Option<&[[f64; 3]; 3]>, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
 
 /// Whether `r` (row-major) is a proper rotation: orthonormal columns to `tol` and determinant
 /// positive (false for any non-finite entry).
-pub(crate) fn is_rotation(r: [[f64; 3]; 3], tol: f64) -> bool {
+pub fn is_rotation(r: [[f64; 3]; 3], tol: f64) -> bool {
     let ortho = (0..3).all(|i| {
         (0..3).all(|j| {
             let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();

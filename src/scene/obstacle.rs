@@ -46,6 +46,45 @@ impl ObstacleShape {
     pub fn cylinder(half_height: f64, radius: f64) -> ObstacleShape {
         ObstacleShape::Cylinder(Cylinder::new(half_height, radius))
     }
+
+    /// A closed triangle mesh whose faces wind counter-clockwise seen from outside; `Err` says
+    /// what is wrong with it (an index out of range, a hole, inside-out, flat, …), naming
+    /// triangles by their index.
+    pub fn triangle_mesh(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<ObstacleShape, String> {
+        if let Some(t) = triangles
+            .iter()
+            .position(|t| t.iter().any(|&i| i as usize >= vertices.len()))
+        {
+            return Err(format!(
+                "triangle {t} refers to a vertex beyond the {} given",
+                vertices.len()
+            ));
+        }
+        crate::scene::mesh::check_solid(vertices, triangles)
+            .map_err(|d| d.describe(|t| format!("triangle {t}")))?;
+        Self::checked_triangle_mesh(vertices, triangles.to_vec())
+    }
+
+    /// The parry mesh of a mesh that [`crate::scene::mesh::check_solid`] accepted.
+    pub(crate) fn checked_triangle_mesh(
+        vertices: &[[f64; 3]],
+        triangles: Vec<[u32; 3]>,
+    ) -> Result<ObstacleShape, String> {
+        use parry3d_f64::shape::TriMeshFlags;
+        let verts = vertices.iter().map(|p| Vector::new(p[0], p[1], p[2]));
+        let mesh = TriMesh::with_flags(
+            verts.collect(),
+            triangles,
+            TriMeshFlags::ORIENTED
+                | TriMeshFlags::MERGE_DUPLICATE_VERTICES
+                | TriMeshFlags::FIX_INTERNAL_EDGES,
+        )
+        .map_err(|e| format!("invalid mesh: {e:?}"))?;
+        Ok(ObstacleShape::TriMesh(Arc::new(mesh)))
+    }
 }
 
 impl std::fmt::Debug for ObstacleShape {

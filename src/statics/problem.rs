@@ -72,6 +72,17 @@ impl StaticProblem {
         default_start(&self.model.layout, delta, self.model.base)
     }
 
+    /// The obstacles among the constraints, in their order.
+    pub fn obstacles(&self) -> Vec<std::sync::Arc<crate::scene::Obstacle>> {
+        self.constraints
+            .iter()
+            .filter_map(|c| match c {
+                Constraint::Obstacle(o) => Some(o.obstacle.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// The constraint block violated most at `a` (label and violation in units of L), if any
     /// is violated by more than `tol`: what keeps a failed solve from its target.
     pub fn most_violated(&mut self, a: &[f64], tol: f64) -> Option<(String, f64)> {

@@ -169,4 +169,36 @@ impl ShapeReport {
             timing_s: secs,
         }
     }
+
+    /// Report of coefficients `a` evaluated without optimising (`dlo energy`).
+    pub fn evaluated(
+        name: &str,
+        p: &StaticProblem,
+        ev: crate::statics::Evaluation,
+        a: &[f64],
+        points: &[f64],
+        secs: f64,
+    ) -> Self {
+        ShapeReport {
+            case: name.into(),
+            status: "evaluated".into(),
+            energy: ev.energy.into(),
+            reactions: ev.reactions,
+            balance: ev.balance,
+            self_contacts: ev.self_contacts,
+            max_violation: ev.max_violation,
+            kkt_residual: Some(ev.kkt_residual),
+            stable: None,
+            stability: None,
+            min_reduced_eigenvalue: None,
+            neutral_modes: None,
+            gauge_modes: None,
+            end_pose: pose(p, a, p.model.rod.length),
+            points: points.iter().map(|&s| pose(p, a, s)).collect(),
+            coefficients: coefficients_json(p, a),
+            angle_frame: p.model.angle_frame(),
+            outer_iterations: None,
+            timing_s: secs,
+        }
+    }
 }

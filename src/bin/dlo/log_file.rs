@@ -16,23 +16,13 @@ pub(crate) static COOPERATIVE: std::sync::atomic::AtomicBool =
 /// Set by the first Ctrl-C of a plan; the plan's observer reads it.
 pub(crate) static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
-/// Where the log bound for `path` is written until it is finished: a name of this process's own
-/// beside it, so that a run killed hard leaves the previous run's finished log whole (and its
-/// own finished chunks, for `dlo recover`), and two runs at once never write one file.
-pub(crate) fn partial_path(path: &Path) -> PathBuf {
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".{}.partial", std::process::id()));
-    path.with_file_name(name)
-}
+pub(crate) use dlo_planner::output::mcap_log::file::partial_path;
 
 /// Opens the log bound for `dir/<name>.mcap` (under [`partial_path`], its header on disk at
 /// once) and arms the Ctrl-C and SIGTERM handler to finish it.
 pub(crate) fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf), ExitCode> {
     let path = dir.join(format!("{name}.mcap"));
-    let tmp = partial_path(&path);
-    let created = McapWriter::create(&tmp).and_then(|mut w| w.flush().map(|()| w));
-    let w = created.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+    let shared = dlo_planner::output::mcap_log::file::create(&path).map_err(|e| {
         eprintln!(
             "error: {}: cannot create the log: {}",
             path.display(),
@@ -40,7 +30,6 @@ pub(crate) fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf)
         );
         ExitCode::from(EXIT_OUTPUT)
     })?;
-    let shared: SharedWriter = Arc::new(Mutex::new(w));
     if ACTIVE_LOG.set((shared.clone(), path.clone())).is_ok() {
         let _ = ctrlc::set_handler(|| {
             use std::sync::atomic::Ordering::SeqCst;
@@ -63,30 +52,15 @@ pub(crate) fn open_log(dir: &Path, name: &str) -> Result<(SharedWriter, PathBuf)
 /// Finishes a log and moves it into place; reports failure as exit code 1 and then leaves no
 /// half-written file.
 pub(crate) fn close_log(w: &SharedWriter, path: &Path) -> Result<(), ExitCode> {
-    let tmp = partial_path(path);
-    let mut guard = dlo_planner::output::mcap_log::lock(w);
-    let was_open = !guard.is_finished();
-    let finished = guard.finish().map_err(|e| causes(&e));
-    drop(guard);
-    let moved = match finished {
-        Ok(()) if was_open => std::fs::rename(&tmp, path).map_err(|e| e.to_string()),
-        other => other,
-    };
-    moved.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+    dlo_planner::output::mcap_log::file::finish(w, path).map_err(|e| {
         eprintln!("error: {}: cannot finish the log: {e}", path.display());
         ExitCode::from(EXIT_OUTPUT)
     })
 }
 
-/// Writes `text` to `path` through a temporary file ([`partial_path`], as the log) moved into
-/// place, so that a failed write leaves no half-written file (and an earlier run's file stays
-/// whole until the new one is).
+/// Writes `text` to `path` atomically (see [`dlo_planner::output::mcap_log::file`]).
 pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<(), ExitCode> {
-    let tmp = partial_path(path);
-    let written = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
-    written.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+    dlo_planner::output::mcap_log::file::write_atomically(path, text).map_err(|e| {
         eprintln!("error: {}: cannot write: {e}", path.display());
         ExitCode::from(EXIT_OUTPUT)
     })

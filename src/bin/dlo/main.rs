@@ -27,15 +27,15 @@ use shape::*;
 
 use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
-use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter, log_static};
+use dlo_planner::output::mcap_log::{PlanLog, SharedWriter, log_static};
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
 use dlo_planner::planner::{PlanVerdict, Planner};
-use dlo_planner::statics::report::{ShapeReport, coefficients_json, pose};
+use dlo_planner::statics::report::ShapeReport;
 use dlo_planner::statics::{evaluate_shape, solve_static};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// Exit code: an output could not be written.

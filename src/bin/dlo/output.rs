@@ -18,14 +18,4 @@ pub(crate) fn emit(text: &str) {
     }
 }
 
-/// An error and its chain of causes, `outer: inner: …` (the MCAP crate wraps I/O errors in a
-/// generic message whose cause says what went wrong).
-pub(crate) fn causes(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        text.push_str(&format!(": {s}"));
-        source = s.source();
-    }
-    text
-}
+pub(crate) use dlo_planner::error::causes;

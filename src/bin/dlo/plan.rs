@@ -53,18 +53,7 @@ impl PlanObserver for CliObserver {
     }
 }
 
-#[derive(serde::Serialize)]
-pub(crate) struct PlanReport<'a> {
-    case: &'a str,
-    verdict: dlo_planner::planner::PlanVerdict,
-    #[serde(flatten)]
-    result: &'a dlo_planner::planner::PlanResult,
-    start_energy: f64,
-    goal_energy: f64,
-    mcap: String,
-    log_shapes: u64,
-    trajectory_csv: String,
-}
+use dlo_planner::planner::PlanReport;
 
 /// The validated `--max-speed` and `--max-angular-speed` (the latter infinite when absent).
 pub(crate) fn speed_limits(v: Option<f64>, w: Option<f64>) -> Result<Option<[f64; 2]>, ExitCode> {
@@ -138,14 +127,10 @@ pub(crate) fn run_plan(
         return code;
     }
     let report = PlanReport {
-        case: &c.name,
-        verdict: result.verdict(),
-        result: &result,
-        start_energy: planner.start.energy.internal(),
-        goal_energy: planner.goal.energy.internal(),
-        mcap: log_path.display().to_string(),
-        log_shapes: obs.log.shapes(),
-        trajectory_csv: csv_path.display().to_string(),
+        mcap: Some(log_path.display().to_string()),
+        log_shapes: Some(obs.log.shapes()),
+        trajectory_csv: Some(csv_path.display().to_string()),
+        ..PlanReport::new(&c.name, &planner, &result)
     };
     if json {
         emit(&format!(
@@ -324,12 +309,16 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         t.largest_rotation_step,
         t.duration_s
             .map_or(String::new(), |d| format!("; duration {d:.3} s")),
-        r.trajectory_csv
+        r.trajectory_csv.as_deref().unwrap_or("not written")
     );
     let _ = writeln!(
         o,
         "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",
-        r.mcap, r.log_shapes, p.timing_s.endpoints, p.timing_s.plan, p.timing_s.replay
+        r.mcap.as_deref().unwrap_or("not written"),
+        r.log_shapes.unwrap_or(0),
+        p.timing_s.endpoints,
+        p.timing_s.plan,
+        p.timing_s.replay
     );
     o
 }

@@ -53,28 +53,8 @@ pub(crate) fn run_energy(path: &std::path::Path, json: bool) -> ExitCode {
     let t0 = Instant::now();
     let a = c.initial.clone();
     let ev = evaluate_shape(&mut c.problem, &a);
-    let p = &c.problem;
-    let report = ShapeReport {
-        case: c.name.clone(),
-        status: "evaluated".into(),
-        energy: ev.energy.into(),
-        reactions: ev.reactions,
-        balance: ev.balance,
-        self_contacts: ev.self_contacts,
-        max_violation: ev.max_violation,
-        kkt_residual: Some(ev.kkt_residual),
-        stable: None,
-        stability: None,
-        min_reduced_eigenvalue: None,
-        neutral_modes: None,
-        gauge_modes: None,
-        end_pose: pose(p, &a, p.model.rod.length),
-        points: c.report_points.iter().map(|&s| pose(p, &a, s)).collect(),
-        coefficients: coefficients_json(p, &a),
-        angle_frame: p.model.angle_frame(),
-        outer_iterations: None,
-        timing_s: t0.elapsed().as_secs_f64(),
-    };
+    let secs = t0.elapsed().as_secs_f64();
+    let report = ShapeReport::evaluated(&c.name, &c.problem, ev, &a, &c.report_points, secs);
     print_report(&report, json);
     ExitCode::SUCCESS
 }

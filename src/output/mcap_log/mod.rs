@@ -2,6 +2,7 @@
 //! ([`scene`]), the planner's observer ([`plan_log`]), and tools for finished or broken files
 //! ([`reader`], [`inspect`], [`recover`]).
 
+pub mod file;
 pub mod inspect;
 pub mod plan_log;
 pub mod reader;

@@ -1,0 +1,136 @@
+//! Plans from Python: a problem built in code or a case file's, run without the GIL, logged
+//! and reported as `dlo plan` does.
+
+use crate::errors::setup_error;
+use crate::model::{End, StaticProblem, static_settings};
+use crate::observer::PyObserver;
+use dlo_planner::output::mcap_log::PlanLog;
+use dlo_planner::planner::{PlanProblem, PlanReport, PlanSettings, Planner};
+use dlo_planner::scene::Obstacle;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Plans how the controlled end (`s = L`) takes the rod held as `problem` says from `start` to
+/// `goal` (see `dlo_planner.plan`).
+#[pyfunction]
+#[pyo3(signature = (problem, start, goal, settings=None, solver=None, progress=None, log_dir=None, name="plan", max_speed=None, max_angular_speed=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn plan(
+    py: Python<'_>,
+    problem: &StaticProblem,
+    start: &End,
+    goal: &End,
+    settings: Option<&Bound<'_, PyAny>>,
+    solver: Option<&Bound<'_, PyAny>>,
+    progress: Option<Py<PyAny>>,
+    log_dir: Option<PathBuf>,
+    name: &str,
+    max_speed: Option<f64>,
+    max_angular_speed: Option<f64>,
+) -> PyResult<Py<PyAny>> {
+    let settings: PlanSettings = crate::settings::merged(settings, "plan")?;
+    let static_settings = static_settings(solver)?;
+    let held = problem.build()?;
+    let (start, goal) = (start.resolve(&held), goal.resolve(&held));
+    let mut plan_problem = PlanProblem::new(held, start, goal);
+    plan_problem.static_settings = static_settings;
+    let speeds = speed_limits(max_speed, max_angular_speed)?;
+    let t0 = Instant::now();
+    let planner = py
+        .detach(|| Planner::new(plan_problem, settings))
+        .map_err(setup_error)?;
+    let obstacles = planner.obstacles.clone();
+    let run = Run {
+        name: name.to_string(),
+        obstacles,
+        endpoints_s: t0.elapsed().as_secs_f64(),
+        progress,
+        log_dir,
+        speeds,
+    };
+    run.go(py, &planner)
+}
+
+/// The validated speed limits of a time parameterisation (`None` without one).
+pub(crate) fn speed_limits(v: Option<f64>, w: Option<f64>) -> PyResult<Option<[f64; 2]>> {
+    let Some(v) = v else { return Ok(None) };
+    let w = w.unwrap_or(f64::INFINITY);
+    if !(v > 0.0 && v.is_finite()) {
+        return Err(crate::errors::input_error(
+            Some("max_speed"),
+            format!("must be a positive finite number, got {v}"),
+        ));
+    }
+    if w.is_nan() || w <= 0.0 {
+        return Err(crate::errors::input_error(
+            Some("max_angular_speed"),
+            format!("must be a positive number, got {w}"),
+        ));
+    }
+    Ok(Some([v, w]))
+}
+
+/// One run of a ready planner and what to do with it.
+pub(crate) struct Run {
+    pub(crate) name: String,
+    pub(crate) obstacles: Vec<Arc<Obstacle>>,
+    /// Seconds the start and goal solves took.
+    pub(crate) endpoints_s: f64,
+    pub(crate) progress: Option<Py<PyAny>>,
+    pub(crate) log_dir: Option<PathBuf>,
+    pub(crate) speeds: Option<[f64; 2]>,
+}
+
+impl Run {
+    /// Runs the plan without the GIL; writes the log and the trajectory CSV (when `log_dir` is
+    /// set, as `dlo plan` writes them); returns a `dlo_planner.results.Plan`, or raises what
+    /// the progress callback raised (a `KeyboardInterrupt` on Ctrl-C) once the log is
+    /// finished.
+    pub(crate) fn go(self, py: Python<'_>, planner: &Planner) -> PyResult<Py<PyAny>> {
+        let log = match &self.log_dir {
+            Some(dir) => Some(crate::logs::open(dir, &self.name)?),
+            None => None,
+        };
+        let mut obs = PyObserver {
+            log: log
+                .as_ref()
+                .map(|(w, _)| PlanLog::new(w.clone(), self.obstacles.clone())),
+            callback: self.progress,
+            error: None,
+            stop: false,
+        };
+        let mut result = py.detach(|| planner.run(&mut obs));
+        result.timing_s.endpoints = self.endpoints_s;
+        if let Some([v, w]) = self.speeds {
+            result.trajectory.time_parameterise(v, w);
+        }
+        let mut report = PlanReport::new(&self.name, planner, &result);
+        if let (Some((w, path)), Some(dir)) = (&log, &self.log_dir) {
+            let log_error = obs
+                .log
+                .as_ref()
+                .and_then(|l| l.error())
+                .map(|e| dlo_planner::error::causes(e));
+            crate::logs::close(w, path)?;
+            if let Some(e) = log_error {
+                return Err(crate::errors::output_error(path, e));
+            }
+            report.mcap = Some(path.display().to_string());
+            report.log_shapes = obs.log.as_ref().map(|l| l.shapes());
+            if result.verdict() != dlo_planner::planner::PlanVerdict::Interrupted {
+                let csv = dir.join(format!("{}.trajectory.csv", self.name));
+                crate::logs::write(&csv, &result.trajectory.to_csv())?;
+                report.trajectory_csv = Some(csv.display().to_string());
+            }
+        }
+        if let Some(e) = obs.error {
+            return Err(e);
+        }
+        let value = serde_json::to_value(&report).expect("report serialises");
+        let text = serde_json::to_string(&value).expect("report serialises");
+        let class = py.import("dlo_planner.results")?.getattr("Plan")?;
+        Ok(class.call1((text,))?.unbind())
+    }
+}

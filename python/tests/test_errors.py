@@ -1,0 +1,90 @@
+"""Bad input raises `InputError` naming the field; nothing is half-written."""
+
+import json
+
+import numpy as np
+import pytest
+
+import dlo_planner as dlo
+from conftest import CASES
+
+
+def field_of(call) -> str:
+    with pytest.raises(dlo.InputError) as err:
+        call()
+    assert err.value.message and err.value.field in str(err.value)
+    return err.value.field
+
+
+def rod():
+    return dlo.Rod(length=1.0, flexural_rigidity=1.0)
+
+
+def test_rod_fields():
+    assert field_of(lambda: dlo.Rod(length=-1.0, flexural_rigidity=1.0)) == "length"
+    assert field_of(lambda: dlo.Rod(1.0, float("nan"))) == "flexural_rigidity"
+    assert field_of(lambda: dlo.Rod(1.0, 1.0, radius=0.7)) == "radius"
+    assert isinstance(dlo.InputError("x"), ValueError)
+
+
+def test_problem_fields():
+    assert field_of(lambda: dlo.StaticProblem(rod(), basis_pairs=99)) == "basis_pairs"
+    assert field_of(lambda: dlo.StaticProblem(rod(), basis="chebyshev")) == "basis"
+    beyond = dlo.StaticProblem(rod()).fix_point(2.0, [0, 0, 1])
+    assert field_of(lambda: beyond.solve()).startswith("constraint")
+    clamp = dlo.StaticProblem(rod()).clamp(0.0, [0, 0, 0], [0.0, 1.0])
+    assert field_of(lambda: clamp.solve()).startswith("constraint")
+    ok = dlo.StaticProblem(rod()).clamp(0.0, [0, 0, 0], [0.0])
+    assert field_of(lambda: ok.solve(initial=[0.0, 1.0])) == "initial"
+    assert field_of(lambda: ok.solve(settings={"rho_initial": -1})) == "rho_initial"
+    assert field_of(lambda: ok.solve(settings={"max_outter": 3})) == "max_outter"
+    assert field_of(lambda: ok.solve(settings={"max_outer": "many"})) == "max_outer"
+    assert field_of(lambda: ok.position(0.5, at_least={"w": 1.0})) == "at_least.w"
+
+
+def test_obstacle_fields():
+    assert field_of(lambda: dlo.Obstacle.ball("b", 0.0, [0, 0, 0])) == "radius"
+    assert field_of(lambda: dlo.Obstacle.ball("b", 0.1, [0, float("inf"), 0])) == "position[1]"
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    closed = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    dlo.Obstacle.mesh("tet", v, closed)
+    assert field_of(lambda: dlo.Obstacle.mesh("open", v, closed[:3])) == "triangles"
+    assert field_of(lambda: dlo.Obstacle.mesh("inside-out", v, closed[:, ::-1])) == "triangles"
+    assert field_of(lambda: dlo.Obstacle.mesh("bad index", v, closed + 1)) == "triangles"
+
+
+def test_plan_fields():
+    held = dlo.StaticProblem(rod()).clamp(0.0, [0, 0, 0], [0.0])
+    start = dlo.End.pose([0.5, 0, 0.7], quaternion=[1, 0, 0, 0])
+    goal = dlo.End.pose([-0.5, 0, 0.7], quaternion=[1, 0, 0, 0])
+    assert field_of(lambda: dlo.plan(held, start, goal, settings={"path_terms": 0})) == "path_terms"
+    assert field_of(lambda: dlo.plan(held, start, goal, settings={"k_sample": 5})) == "k_sample"
+    assert field_of(lambda: dlo.plan(held, start, goal, max_speed=-1.0)) == "max_speed"
+    far = dlo.End.pose([5.0, 0, 0.7], quaternion=[1, 0, 0, 0])
+    assert field_of(lambda: dlo.plan(held, far, goal)) == "start"
+    assert field_of(lambda: dlo.End.pose([0, 0, 1], quaternion=[2, 0, 0, 0])) == "quaternion"
+    assert field_of(lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 2]])) == "rotation"
+    assert field_of(lambda: dlo.End.pose([0, 0, 1])) == "rotation"
+
+
+def test_case_fields(tmp_path):
+    text = json.loads((CASES / "pinned_buckling_080.json").read_text())
+    text["rod"]["length"] = -3
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(text))
+    assert field_of(lambda: dlo.Case.load(bad)) == "rod.length"
+    with pytest.raises(dlo.InputError) as err:
+        dlo.Case.parse("{ not json")
+    assert err.value.field is None
+    with pytest.raises(OSError):
+        dlo.Case.load(tmp_path / "missing.json")
+    assert field_of(lambda: dlo.Case.load(CASES / "pinned_buckling_080.json").evaluate()) == "shape"
+    assert field_of(lambda: dlo.Case.load(CASES / "pinned_buckling_080.json").margin()) == "grasp"
+
+
+def test_an_unwritable_log_leaves_nothing(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    with pytest.raises(OSError):
+        dlo.Case.load(CASES / "pinned_buckling_080.json").solve(log_dir=blocker / "logs")
+    assert list(tmp_path.iterdir()) == [blocker]

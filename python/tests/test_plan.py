@@ -1,0 +1,111 @@
+"""Plans from Python: equal to the CLI's, logged as the CLI logs, observed and stopped."""
+
+import math
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import dlo_planner as dlo
+from conftest import CASES, cli_json
+
+PAPER = CASES / "plan_paper_planar.json"
+
+
+def strip_files_and_timing(report: dict) -> dict:
+    report = dict(report)
+    report.pop("timing_s")
+    for key in ("mcap", "trajectory_csv"):
+        report.pop(key, None)
+    return report
+
+
+def test_a_plan_equals_the_cli_report(dlo_bin, tmp_path, log_dir):
+    cli = cli_json(dlo_bin, "plan", str(PAPER), "--log-dir", str(tmp_path))
+    plan = dlo.Case.load(PAPER).plan(log_dir=log_dir)
+    assert strip_files_and_timing(plan.to_dict()) == strip_files_and_timing(cli)
+    assert plan.executable and plan.verdict == "executable"
+    # The trajectory CSV is the CLI's, byte for byte.
+    ours = (log_dir / "plan_paper_planar.trajectory.csv").read_bytes()
+    assert ours == (tmp_path / "plan_paper_planar.trajectory.csv").read_bytes()
+    # The log holds what the CLI's holds: the same topics, schemas and message counts (its
+    # times start at the wall clock's now).
+    def topics(path):
+        found = cli_json(dlo_bin, "inspect", str(path))["topics"]
+        return {t: (v["schema"], v["encoding"], v["messages"]) for t, v in found.items()}
+
+    assert topics(log_dir / "plan_paper_planar.mcap") == topics(tmp_path / "plan_paper_planar.mcap")
+
+
+def test_the_gripper_arrays_are_the_report():
+    plan = dlo.Case.load(PAPER).plan(max_speed=0.5)
+    poses = plan.trajectory.poses
+    assert len(poses) == len(plan.gripper.k) > 2
+    np.testing.assert_array_equal(plan.gripper.positions[3], poses[3].position)
+    np.testing.assert_allclose(np.linalg.norm(plan.gripper.quaternions, axis=1), 1.0, atol=1e-12)
+    assert plan.gripper.time_s is not None and plan.gripper.time_s[-1] == plan.trajectory.duration_s
+    # Each step respects the speed limit.
+    steps = np.linalg.norm(np.diff(plan.gripper.positions, axis=0), axis=1)
+    assert np.all(steps <= 0.5 * np.diff(plan.gripper.time_s) * (1 + 1e-9))
+
+
+def block_problem() -> tuple:
+    """The README's plan built in code: a strip under a block, swung from side to side."""
+    rod = dlo.Rod(length=1.0, flexural_rigidity=1.0, radius=0.005)
+    block = dlo.Obstacle.cuboid("block", [0.1, 0.5, 0.25], position=[0.0, 0.0, 1.1])
+    held = dlo.StaticProblem(rod).clamp(0.0, [0, 0, 0], [0.0]).obstacle(block)
+    turn = lambda t: [[math.cos(t), 0, math.sin(t)], [0, 1, 0], [-math.sin(t), 0, math.cos(t)]]  # noqa: E731
+    start = dlo.End.pose([0.5, 0.0, 0.6], rotation=turn(math.pi / 2))
+    goal = dlo.End.pose([-0.5, 0.0, 0.6], rotation=turn(-math.pi / 2))
+    return held, start, goal
+
+
+def test_a_plan_built_in_code_is_executable(log_dir):
+    held, start, goal = block_problem()
+    events = []
+    plan = dlo.plan(held, start, goal, progress=lambda e, info: events.append(e), log_dir=log_dir, name="python_block")
+    assert plan.executable, plan.verdict
+    # The straight path runs through the block; the plan goes round it.
+    assert plan.min_clearance_straight < 0 < plan.min_clearance
+    assert {"phase", "iteration", "replay"} <= set(events)
+    # A quaternion gives the same end shape as its matrix (the plans may differ: the path
+    # optimiser is local, and a last-digit difference moves its start).
+    q = dlo.End.pose([0.5, 0.0, 0.6], quaternion=[math.cos(math.pi / 4), 0, math.sin(math.pi / 4), 0])
+    again = dlo.plan(held, q, goal)
+    assert again.start_energy == pytest.approx(plan.start_energy, rel=1e-9)
+
+
+def test_a_callback_stops_a_plan_and_its_log_is_finished(log_dir):
+    held, start, goal = block_problem()
+    plan = dlo.plan(held, start, goal, progress=lambda e, info: e == "iteration", log_dir=log_dir, name="python_stopped")
+    assert plan.verdict == "interrupted" and not plan.executable
+    assert (log_dir / "python_stopped.mcap").stat().st_size > 0
+    with pytest.raises(ZeroDivisionError):
+        dlo.plan(held, start, goal, progress=lambda e, info: 1 / 0)
+
+
+def test_two_threads_plan_at_once_faster_than_one_after_the_other():
+    held, start, goal = block_problem()
+    settings = {"starts": 1}
+    dlo.plan(held, start, goal, settings=settings)  # warm
+    t0 = time.perf_counter()
+    serial = [dlo.plan(held, start, goal, settings=settings) for _ in range(2)]
+    t_serial = time.perf_counter() - t0
+    results = [None, None]
+
+    def work(i):
+        results[i] = dlo.plan(held, start, goal, settings=settings)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    t_threads = time.perf_counter() - t0
+    assert [r.u_max for r in results] == [r.u_max for r in serial]
+    # With the GIL held they would take as long as one after the other; released, the two
+    # cores share them (ideal 0.5).
+    assert t_threads < 0.8 * t_serial, (t_threads, t_serial)

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# The tests: the Rust crate's (`cargo test --release`), then the Python package built and
+# installed into a virtual environment (target/venv, with pytest and Ray) and its pytest
+# suite. Arguments go to `cargo test`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo test --release --locked "$@"
+venv=target/venv
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+"$venv/bin/python" -m pip install --quiet --upgrade "./python[test,ray]"
+"$venv/bin/python" -m pytest -q python/tests
