@@ -92,10 +92,26 @@ class StaticShape(Report):
 
     def __init__(self, report: str, a, s, positions, frames):
         super().__init__(report)
+        # Flat lists from the core, made arrays when first read.
+        self._raw = (a, s, positions, frames)
+
+    def _arrays(self) -> None:
+        a, s, positions, frames = self.__dict__.pop("_raw")
         self.a = np.asarray(a, dtype=float)
         self.s = np.asarray(s, dtype=float)
         self.positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         self.frames = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
+
+    def __getattr__(self, name: str) -> Any:
+        if name in ("a", "s", "positions", "frames") and "_raw" in self.__dict__:
+            self._arrays()
+            return self.__dict__[name]
+        return super().__getattr__(name)
+
+    def __getstate__(self) -> dict:
+        if "_raw" in self.__dict__:
+            self._arrays()
+        return super().__getstate__()
 
     @property
     def converged(self) -> bool:

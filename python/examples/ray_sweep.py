@@ -1,5 +1,6 @@
 """A parameter sweep of static shapes on Ray: the pinned elastica (L = 100, Rf = 1, both ends
-pinned on the z axis) over chord ratios l/L and lengths, each task solving a batch of shapes.
+pinned on the z axis) over chord ratios l/L and lengths, in one batch per CPU, each solved by
+a Ray actor that stays warm between sweeps (plain tasks, `on_ray(params, batches)`, work too).
 
     python python/examples/ray_sweep.py --shapes 1000 --workers 2      # a local Ray
     python python/examples/ray_sweep.py --shapes 1000 --compare        # and the serial loop
@@ -45,14 +46,35 @@ def serial(params: list[tuple[float, float]]) -> list[tuple[float, float, float,
     return solve_batch(params)
 
 
-def on_ray(params: list[tuple[float, float]], batches: int) -> list[tuple[float, float, float, str]]:
-    """The sweep as `batches` Ray tasks, results in the order of `params`."""
+def on_ray(params: list[tuple[float, float]], batches: int, workers: list | None = None) -> list[tuple[float, float, float, str]]:
+    """The sweep as `batches` Ray tasks, results in the order of `params`; on `workers`
+    (actors from `solvers`, which keep their imports warm) when given."""
     import ray
 
-    task = ray.remote(solve_batch)
     size = -(-len(params) // batches)
-    refs = [task.remote(params[i : i + size]) for i in range(0, len(params), size)]
+    parts = [params[i : i + size] for i in range(0, len(params), size)]
+    if workers:
+        refs = [workers[i % len(workers)].solve_batch.remote(p) for i, p in enumerate(parts)]
+    else:
+        task = ray.remote(solve_batch)
+        refs = [task.remote(p) for p in parts]
     return [row for part in ray.get(refs) for row in part]
+
+
+class Solver:
+    """A Ray actor that solves batches: one per CPU, started once."""
+
+    def solve_batch(self, batch: list[tuple[float, float]]) -> list[tuple[float, float, float, str]]:
+        return solve_batch(batch)
+
+
+def solvers(n: int) -> list:
+    """`n` warm solver actors."""
+    import ray
+
+    actors = [ray.remote(num_cpus=1)(Solver).remote() for _ in range(n)]
+    ray.get([a.solve_batch.remote([(0.5, 100.0)]) for a in actors])
+    return actors
 
 
 def start_ray(workers: int, address: str | None):
@@ -78,11 +100,11 @@ def main() -> None:
     ray = start_ray(args.workers, args.address)
     cpus = int(ray.cluster_resources().get("CPU", args.workers))
     batches = args.batches or cpus
-    on_ray(params[: 2 * batches], batches)  # warm the workers (imports)
+    workers = solvers(cpus)
     t_ray = float("inf")
     for _ in range(args.repeats):
         t0 = time.perf_counter()
-        rows = on_ray(params, batches)
+        rows = on_ray(params, batches, workers)
         t_ray = min(t_ray, time.perf_counter() - t0)
     converged = sum(r[3] == "converged" for r in rows)
     print(f"ray: {len(rows)} shapes on {cpus} CPUs in {t_ray:.3f} s ({converged} converged)")

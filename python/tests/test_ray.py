@@ -20,9 +20,10 @@ def test_a_ray_sweep_equals_the_serial_loop():
     ray = sweep.start_ray(workers=2, address=None)
     try:
         rows = sweep.on_ray(params, batches=8)
+        on_actors = sweep.on_ray(params, batches=2, workers=sweep.solvers(2))
     finally:
         ray.shutdown()
-    assert rows == reference
+    assert rows == reference and on_actors == reference
     assert all(status == "converged" for *_, status in rows)
     # Sanity against Euler's load: a pinned rod buckles at π² Rf / L²; the elastica needs more.
     for (ratio, length), (force, *_rest) in zip(params, rows):

@@ -138,3 +138,12 @@ def test_case_reports_equal_the_cli(dlo_bin, tmp_path, case):
         r.pop("timing_s")
         r.pop("mcap", None)
     assert ours == cli
+
+
+def test_results_pickle_for_process_pools():
+    import pickle
+
+    shape = pinned_elastica().solve()
+    back = pickle.loads(pickle.dumps(shape))
+    assert back == shape and back.energy.total == shape.energy.total
+    np.testing.assert_array_equal(back.positions, shape.positions)
