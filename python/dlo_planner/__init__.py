@@ -19,7 +19,8 @@ or run a case file as the `dlo` command does::
 Every solve releases the GIL, so threads and process pools run in parallel. Results are the
 classes of :mod:`dlo_planner.results`: the CLI's JSON report as attributes (``to_dict()``
 gives the dict itself) plus NumPy arrays. Bad input raises :class:`InputError` (a
-``ValueError``) whose ``field`` and ``message`` say what is wrong.
+``ValueError``) whose ``field`` and ``message`` say what is wrong; a plan's start or goal that
+no static shape reaches raises its subclass :class:`UnreachableError`.
 """
 
 from ._dlo import (
@@ -29,6 +30,7 @@ from ._dlo import (
     Obstacle,
     Rod,
     StaticProblem,
+    UnreachableError,
     __version__,
     grasp_margin,
     plan,
@@ -47,6 +49,7 @@ __all__ = [
     "StaticProblem",
     "StaticShape",
     "Trajectory",
+    "UnreachableError",
     "__version__",
     "grasp_margin",
     "plan",

@@ -5,6 +5,7 @@ from ._dlo import (
     Obstacle as Obstacle,
     Rod as Rod,
     StaticProblem as StaticProblem,
+    UnreachableError as UnreachableError,
     __version__ as __version__,
     grasp_margin as grasp_margin,
     plan as plan,

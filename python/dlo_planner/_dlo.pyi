@@ -24,6 +24,9 @@ class InputError(ValueError):
     field: Optional[str]
     message: str
 
+class UnreachableError(InputError):
+    """No static shape reaches a plan's start or goal (``field``): nothing was planned."""
+
 class Rod:
     """A uniform rod in consistent units. A rod with ``torsional_rigidity`` is 3D; without, it
     is planar (it lies in the x–z plane). ``radius`` defaults to ``length / 1000``. Gravity acts

@@ -115,9 +115,21 @@ impl Case {
     ) -> PyResult<Py<PyAny>> {
         let speeds = crate::plan::speed_limits(max_speed, max_angular_speed)?;
         let t0 = Instant::now();
+        use dlo_planner::case::plan::{plan_problem, setup_error};
+        use dlo_planner::planner::PlanSetupError;
+        let (problem, settings) = plan_problem(&self.inner).map_err(case_error)?;
         let planner = py
-            .detach(|| Planner::from_case(&self.inner))
-            .map_err(case_error)?;
+            .detach(|| Planner::new(problem, settings))
+            .map_err(|e| match e {
+                PlanSetupError::Unreachable { end, message } => {
+                    let path = self.inner.path.display();
+                    crate::errors::unreachable_error(
+                        &format!("plan.{end}"),
+                        format!("{path}: {message}"),
+                    )
+                }
+                other => case_error(setup_error(&self.inner, other)),
+            })?;
         let run = crate::plan::Run {
             name: self.inner.name.clone(),
             obstacles: self.inner.obstacles.clone(),

@@ -12,14 +12,31 @@ pyo3::create_exception!(
      the input could not be parsed far enough to name one) and `message` says what is wrong."
 );
 
+pyo3::create_exception!(
+    dlo_planner,
+    UnreachableError,
+    InputError,
+    "No static shape reaches a plan's start or goal (`field`: `start` or `goal`, `plan.start` \
+     or `plan.goal` for a case file) under the problem's constraints and obstacles: nothing \
+     was planned. `message` names the obstacle the end lies in or the constraint most violated."
+);
+
 /// An [`InputError`] for `field` (none when `None`).
 pub(crate) fn input_error(field: Option<&str>, message: impl Into<String>) -> PyErr {
-    let message = message.into();
+    with_field(InputError::new_err, field, message.into())
+}
+
+/// An [`UnreachableError`] for the end `field`.
+pub(crate) fn unreachable_error(field: &str, message: impl Into<String>) -> PyErr {
+    with_field(UnreachableError::new_err, Some(field), message.into())
+}
+
+fn with_field(new: fn(String) -> PyErr, field: Option<&str>, message: String) -> PyErr {
     let text = match field {
         Some(f) => format!("{f}: {message}"),
         None => message.clone(),
     };
-    let err = InputError::new_err(text);
+    let err = new(text);
     Python::attach(|py| {
         let value = err.value(py);
         let _ = value.setattr("field", field);
@@ -62,6 +79,7 @@ pub(crate) fn setup_error(e: dlo_planner::planner::PlanSetupError) -> PyErr {
         PlanSetupError::Settings(s) => settings_error(s),
         PlanSetupError::Problem(m) => input_error(Some("problem"), m),
         PlanSetupError::End { end, message } => input_error(Some(end), message),
+        PlanSetupError::Unreachable { end, message } => unreachable_error(end, message),
     }
 }
 

@@ -20,6 +20,10 @@ use pyo3::prelude::*;
 fn _dlo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("InputError", m.py().get_type::<errors::InputError>())?;
+    m.add(
+        "UnreachableError",
+        m.py().get_type::<errors::UnreachableError>(),
+    )?;
     m.add_class::<model::Rod>()?;
     m.add_class::<model::Obstacle>()?;
     m.add_class::<model::StaticProblem>()?;

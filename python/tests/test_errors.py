@@ -62,6 +62,8 @@ def test_plan_fields():
     assert field_of(lambda: dlo.plan(held, start, goal, max_speed=-1.0)) == "max_speed"
     far = dlo.End.pose([5.0, 0, 0.7], quaternion=[1, 0, 0, 0])
     assert field_of(lambda: dlo.plan(held, far, goal)) == "start"
+    with pytest.raises(dlo.UnreachableError):
+        dlo.plan(held, far, goal)
     assert field_of(lambda: dlo.End.pose([0, 0, 1], quaternion=[2, 0, 0, 0])) == "quaternion"
     assert field_of(lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 2]])) == "rotation"
     assert field_of(lambda: dlo.End.pose([0, 0, 1])) == "rotation"
@@ -80,6 +82,17 @@ def test_case_fields(tmp_path):
         dlo.Case.load(tmp_path / "missing.json")
     assert field_of(lambda: dlo.Case.load(CASES / "pinned_buckling_080.json").evaluate()) == "shape"
     assert field_of(lambda: dlo.Case.load(CASES / "pinned_buckling_080.json").margin()) == "grasp"
+
+
+def test_an_unreachable_case_goal(tmp_path):
+    text = json.loads((CASES / "plan_paper_planar.json").read_text())
+    text["plan"]["goal"] = {"x": 0.0, "z": 0.9, "theta": 0.0}  # inside the block
+    inside = tmp_path / "inside.json"
+    inside.write_text(json.dumps(text))
+    with pytest.raises(dlo.UnreachableError) as err:
+        dlo.Case.load(inside).plan(log_dir=tmp_path)
+    assert err.value.field == "plan.goal" and "inside obstacle 'block'" in err.value.message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["inside.json"]
 
 
 def test_an_unwritable_log_leaves_nothing(tmp_path):

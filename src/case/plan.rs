@@ -313,29 +313,41 @@ fn split(raw: serde_json::Value) -> Result<(EndSpec, EndSpec, PlanSettings), Str
     Ok((start, goal, settings))
 }
 
+/// The case's `plan` section as a [`PlanProblem`](crate::planner::PlanProblem) and
+/// [`PlanSettings`] for [`Planner::new`](crate::planner::Planner::new).
+pub fn plan_problem(case: &Case) -> Result<(crate::planner::PlanProblem, PlanSettings), Error> {
+    let (start, goal, settings) = plan_section(case)?;
+    let problem = crate::planner::PlanProblem {
+        statics: case.problem.clone(),
+        obstacles: case.obstacles.clone(),
+        start,
+        goal,
+        initial: case.initial.clone(),
+        static_settings: case.file.solver,
+    };
+    Ok((problem, settings))
+}
+
+/// A [`Planner::new`](crate::planner::Planner::new) error in the case file's terms (the
+/// field of its `plan` section).
+pub fn setup_error(case: &Case, e: crate::planner::PlanSetupError) -> Error {
+    use crate::planner::PlanSetupError;
+    match e {
+        PlanSetupError::Settings(s) => {
+            Error::invalid(&case.path, format!("plan.{}", s.field), s.message)
+        }
+        PlanSetupError::Problem(m) => Error::invalid(&case.path, "base.free", m),
+        PlanSetupError::End { end, message } | PlanSetupError::Unreachable { end, message } => {
+            Error::invalid(&case.path, format!("plan.{end}"), message)
+        }
+    }
+}
+
 impl crate::planner::Planner {
-    /// Validates the case's `plan` section and solves the start and goal shapes: the case file
-    /// as a [`PlanProblem`](crate::planner::PlanProblem) and [`PlanSettings`] for
-    /// [`Planner::new`](crate::planner::Planner::new).
+    /// Validates the case's `plan` section and solves the start and goal shapes
+    /// ([`plan_problem`], then [`Planner::new`](crate::planner::Planner::new)).
     pub fn from_case(case: &Case) -> Result<crate::planner::Planner, Error> {
-        use crate::planner::{PlanProblem, PlanSetupError, Planner};
-        let (start, goal, settings) = plan_section(case)?;
-        let problem = PlanProblem {
-            statics: case.problem.clone(),
-            obstacles: case.obstacles.clone(),
-            start,
-            goal,
-            initial: case.initial.clone(),
-            static_settings: case.file.solver,
-        };
-        Planner::new(problem, settings).map_err(|e| match e {
-            PlanSetupError::Settings(s) => {
-                Error::invalid(&case.path, format!("plan.{}", s.field), s.message)
-            }
-            PlanSetupError::Problem(m) => Error::invalid(&case.path, "base.free", m),
-            PlanSetupError::End { end, message } => {
-                Error::invalid(&case.path, format!("plan.{end}"), message)
-            }
-        })
+        let (problem, settings) = plan_problem(case)?;
+        crate::planner::Planner::new(problem, settings).map_err(|e| setup_error(case, e))
     }
 }

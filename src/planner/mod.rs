@@ -87,12 +87,21 @@ pub enum PlanSetupError {
     /// The problem cannot be planned (e.g. a free base).
     #[error("{0}")]
     Problem(String),
-    /// The start or the goal cannot be reached or is ill-posed.
+    /// The start or the goal is ill-posed (e.g. an orientation that is not a rotation).
     #[error("{end}: {message}")]
     End {
         /// `start` or `goal`.
         end: &'static str,
         /// Why.
+        message: String,
+    },
+    /// No static shape reaches the start or the goal under the problem's constraints and
+    /// obstacles (or the given shape violates them): there is nothing to plan between.
+    #[error("{end}: {message}")]
+    Unreachable {
+        /// `start` or `goal`.
+        end: &'static str,
+        /// Why: the obstacle the end lies in, or the constraint most violated.
         message: String,
     },
 }
@@ -267,7 +276,7 @@ fn end_shape(
                 sol.status, sol.max_violation
             )
         };
-        return Err(PlanSetupError::End {
+        return Err(PlanSetupError::Unreachable {
             end: which,
             message: msg,
         });

@@ -55,6 +55,9 @@ pub enum PlanVerdict {
     NotConverged,
     /// The run was stopped before it finished.
     Interrupted,
+    /// No static shape reaches the start or the goal: nothing was planned
+    /// ([`super::PlanSetupError::Unreachable`]; never the verdict of a [`PlanResult`]).
+    Unreachable,
 }
 
 impl PlanVerdict {
@@ -74,6 +77,7 @@ impl std::fmt::Display for PlanVerdict {
             PlanVerdict::SelfCollision => "the rod crosses itself",
             PlanVerdict::NotConverged => "the path optimiser did not converge",
             PlanVerdict::Interrupted => "interrupted",
+            PlanVerdict::Unreachable => "no static shape reaches the start or the goal",
         })
     }
 }

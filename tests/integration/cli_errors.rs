@@ -1106,11 +1106,14 @@ fn limits_warnings_and_blocked_poses_are_reported_before_work() {
             v["plan"]["goal"] = serde_json::json!({"x": 0.0, "z": 0.9, "theta": 0.0})
         }),
     );
-    let (code, _, err) = run(&["plan", p.to_str().unwrap(), "--log-dir", logs]);
-    assert_eq!(code, 2, "{err}");
+    let (code, out, err) = run(&["plan", p.to_str().unwrap(), "--log-dir", logs, "--json"]);
+    assert_eq!(code, 6, "{err}");
     assert!(
         err.contains("plan.goal") && err.contains("inside obstacle 'block'"),
         "{err}"
     );
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(report["verdict"], "unreachable", "{out}");
+    assert_eq!(report["end"], "goal", "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
-/// Exit codes from worst to best: interrupted, output, bad input, not converged, collision,
-/// not coincident, success.
-const SEVERITY: [u8; 7] = [130, 1, 2, 3, 4, 5, 0];
+/// Exit codes from worst to best: interrupted, output, bad input, unreachable start or goal,
+/// not converged, collision, not coincident, success.
+const SEVERITY: [u8; 8] = [130, 1, 2, 6, 3, 4, 5, 0];
 
 fn severity(code: u8) -> usize {
     SEVERITY

@@ -2,7 +2,8 @@
 //!
 //! Exit codes: 0 success; 1 an output could not be written; 2 bad input (case file or usage);
 //! 3 the solver did not converge; 4 no collision-free plan; 5 the replay does not coincide with
-//! the plan; 130 interrupted (the log is finished first).
+//! the plan; 6 no static shape reaches the plan's start or goal; 130 interrupted (the log is
+//! finished first).
 //!
 //! `args.rs` holds the command line; one file per command family (`shape.rs`, `plan.rs`,
 //! `margin.rs`, `logs.rs`) runs it and renders its report; `log_file.rs` owns the log's
@@ -29,7 +30,7 @@ use clap::{Parser, Subcommand};
 use dlo_planner::case::{self, Case};
 use dlo_planner::output::mcap_log::{PlanLog, SharedWriter, log_static};
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
-use dlo_planner::planner::{PlanVerdict, Planner};
+use dlo_planner::planner::{PlanSetupError, PlanVerdict, Planner};
 use dlo_planner::statics::report::ShapeReport;
 use dlo_planner::statics::{evaluate_shape, solve_static};
 use std::io::IsTerminal;
@@ -51,6 +52,8 @@ const EXIT_INTERRUPTED: i32 = 130;
 const EXIT_BAD_INPUT: u8 = 2;
 /// Exit code: the solver did not converge.
 const EXIT_NOT_CONVERGED: u8 = 3;
+/// Exit code: no static shape reaches a plan's start or goal.
+const EXIT_UNREACHABLE: u8 = 6;
 
 fn main() -> ExitCode {
     let code = run();

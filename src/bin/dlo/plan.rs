@@ -80,8 +80,17 @@ pub(crate) fn run_plan(
         Err(code) => return code,
     };
     let t0 = Instant::now();
-    let planner = match Planner::from_case(&c) {
-        Ok(p) => p,
+    let built =
+        case::plan::plan_problem(&c).map(|(problem, settings)| Planner::new(problem, settings));
+    let planner = match built {
+        Ok(Ok(p)) => p,
+        Ok(Err(PlanSetupError::Unreachable { end, message })) => {
+            return unreachable_end(&c, json, end, &message);
+        }
+        Ok(Err(e)) => {
+            eprintln!("error: {}", case::plan::setup_error(&c, e));
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_BAD_INPUT);
@@ -200,7 +209,30 @@ pub(crate) fn run_plan(
         }
         PlanVerdict::Executable => ExitCode::SUCCESS,
         PlanVerdict::Interrupted => ExitCode::from(EXIT_INTERRUPTED as u8),
+        PlanVerdict::Unreachable => ExitCode::from(EXIT_UNREACHABLE),
     }
+}
+
+/// The verdict of a plan whose start or goal no static shape reaches: a report (no plan, no
+/// log) and exit code 6.
+fn unreachable_end(c: &Case, json: bool, end: &str, message: &str) -> ExitCode {
+    let verdict = PlanVerdict::Unreachable;
+    if json {
+        let report = serde_json::json!({
+            "case": c.name, "verdict": verdict, "end": end, "message": message,
+        });
+        emit(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(&report).expect("report serialises")
+        ));
+    } else {
+        emit(&format!("case {}: {verdict}: the {end}\n", c.name));
+    }
+    eprintln!(
+        "error: {}: field `plan.{end}`: {message}; nothing was planned",
+        c.path.display()
+    );
+    ExitCode::from(EXIT_UNREACHABLE)
 }
 
 /// What to try when no plan is collision-free (the case file's `plan` fields).
