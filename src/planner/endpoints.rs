@@ -40,7 +40,8 @@ impl End {
     /// Fills in the angles of a full orientation, in the branch that continues from
     /// `reference` (the Euler angles of the frame it continues from; see
     /// [`super::orientation`]); a planar tie goes to the branch nearer `held` (the held end's
-    /// angles). Errors name the problem (a planar rod's end turned about another axis than y).
+    /// angles). Errors name the problem (a planar rod's end turned about another axis than y,
+    /// a shape of the wrong size or with a non-finite coefficient).
     pub fn resolve(
         &mut self,
         model: &crate::rod::model::Model,
@@ -49,6 +50,18 @@ impl End {
     ) -> Result<(), String> {
         let planar = !model.layout.spatial;
         use crate::rod::layout::Field;
+        if let Some(a) = &self.shape {
+            let n = model.layout.len();
+            if a.len() != n {
+                return Err(format!(
+                    "the shape has {} coefficients; the problem has {n}",
+                    a.len()
+                ));
+            }
+            if let Some(i) = a.iter().position(|x| !x.is_finite()) {
+                return Err(format!("coefficient {i} of the shape is not finite"));
+            }
+        }
         let Some(r) = self.rotation.take() else {
             return Ok(());
         };

@@ -389,6 +389,14 @@ impl Planner {
                 "planning holds the base fixed (the held end); a free base is not supported".into(),
             ));
         }
+        let n = model.layout.len();
+        if problem.initial.len() != n || problem.initial.iter().any(|x| !x.is_finite()) {
+            return Err(PlanSetupError::Problem(format!(
+                "the initial shape must have {n} finite coefficients, got {}",
+                problem.initial.len()
+            )));
+        }
+        problem.static_settings.validate()?;
         // Replay and endpoint solves: the problem's settings, with the optimality tolerance no
         // tighter than 1e-5 (replayed shapes are compared at the 1e-3 L level).
         let mut static_options = problem.static_settings.options();

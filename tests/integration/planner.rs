@@ -1437,3 +1437,48 @@ fn an_observer_stops_a_plan_and_the_result_says_interrupted() {
     let r2 = p2.run(&mut Silent);
     assert_eq!(r2.status, PlanStatus::Interrupted);
 }
+
+/// `Planner::new` refuses ill-formed problems built in code with an error naming the end or
+/// the problem, never a panic: a shape of the wrong size or with a NaN, a wrong-sized
+/// initial shape, bad static settings.
+#[test]
+fn planner_new_refuses_ill_formed_problems_built_in_code() {
+    use dlo_planner::planner::{End, PlanProblem, PlanSettings, PlanSetupError};
+    use dlo_planner::rod::{Rod, layout::Layout};
+    use dlo_planner::statics::StaticProblem;
+    let rod = Rod::uniform(1.0, 1.0);
+    let held = StaticProblem::builder(rod.clone(), Layout::of(&rod, 4))
+        .clamp(0.0, [0.0; 3], &[0.0])
+        .build()
+        .unwrap();
+    let goal = End::pose(
+        &held,
+        [-0.5, 0.0, 0.7],
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    );
+    let plan = |start: End, edit: &dyn Fn(&mut PlanProblem)| {
+        let mut p = PlanProblem::new(held.clone(), start, goal.clone());
+        edit(&mut p);
+        Planner::new(p, PlanSettings::default()).err()
+    };
+    let end_error = |e: Option<PlanSetupError>| match e {
+        Some(PlanSetupError::End { end, message }) => format!("{end}: {message}"),
+        other => panic!("expected an end error, got {other:?}"),
+    };
+    let short = end_error(plan(End::shape(vec![0.0; 3]), &|_| {}));
+    assert!(
+        short.contains("start") && short.contains("has 3 coefficients"),
+        "{short}"
+    );
+    let nan = end_error(plan(End::shape(vec![f64::NAN; 10]), &|_| {}));
+    assert!(nan.contains("not finite"), "{nan}");
+    let ok_start = End::shape(held.natural_start(0.0));
+    assert!(matches!(
+        plan(ok_start.clone(), &|p| p.initial.truncate(2)),
+        Some(PlanSetupError::Problem(m)) if m.contains("initial shape")
+    ));
+    assert!(matches!(
+        plan(ok_start, &|p| p.static_settings.rho_initial = -1.0),
+        Some(PlanSetupError::Settings(s)) if s.field == "rho_initial"
+    ));
+}
