@@ -35,7 +35,7 @@ from ._dlo import (
     grasp_margin,
     plan,
 )
-from .results import Margin, Plan, Report, StaticShape, Trajectory
+from .results import Margin, Plan, Report, Shapes, StaticShape, Trajectory
 
 __all__ = [
     "Case",
@@ -46,6 +46,7 @@ __all__ = [
     "Plan",
     "Report",
     "Rod",
+    "Shapes",
     "StaticProblem",
     "StaticShape",
     "Trajectory",

@@ -14,6 +14,7 @@ from .results import (
     Margin as Margin,
     Plan as Plan,
     Report as Report,
+    Shapes as Shapes,
     StaticShape as StaticShape,
     Trajectory as Trajectory,
 )

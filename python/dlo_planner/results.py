@@ -141,6 +141,22 @@ class Trajectory(Report):
         self.time_s = np.array(times, dtype=float) if poses and None not in times else None
 
 
+class Shapes:
+    """Shapes along a plan: ``k`` (increasing) and ``positions`` (``len(k) × points × 3``, the
+    rod at the quadrature mesh's boundaries, case units)."""
+
+    def __init__(self, k, positions):
+        self.k = np.asarray(k, dtype=float)
+        x = np.asarray(positions, dtype=float)
+        self.positions = x.reshape(len(self.k), -1, 3) if len(self.k) else x.reshape(0, 0, 3)
+
+    def __len__(self) -> int:
+        return len(self.k)
+
+    def __repr__(self) -> str:
+        return f"Shapes({len(self.k)} shapes of {self.positions.shape[1]} points)"
+
+
 class Plan(Report):
     """A plan: the report of ``dlo plan --json`` (``verdict``, ``status``, ``u_max``,
     ``replay``, ``verification``, ``starts``, ``path``, ``trajectory``, …).
@@ -148,10 +164,15 @@ class Plan(Report):
     Attributes:
         gripper: the controlled end's trajectory as arrays (:class:`Trajectory`).
         path: the path vectors ``c_i`` (``m × n`` array) of ``a(c, k)``.
+        planned: the planned shapes at the replay's steps (:class:`Shapes`; empty when the run
+            stopped before the replay).
+        replayed: the shapes the controlled end's motion produces there (:class:`Shapes`).
     """
 
-    def __init__(self, report: str):
+    def __init__(self, report: str, planned=((), ()), replayed=((), ())):
         super().__init__(json.loads(report))
+        self.planned = Shapes(*planned)
+        self.replayed = Shapes(*replayed)
         self.gripper = Trajectory(self._data["trajectory"])
         self.path = np.asarray(self._data["path"], dtype=float)
 

@@ -3,6 +3,7 @@
 //! (`KeyboardInterrupt`), the plan ends as `interrupted` with its log finished.
 
 use dlo_planner::output::mcap_log::PlanLog;
+use dlo_planner::output::mcap_log::plan_log::rod_points;
 use dlo_planner::planner::observer::{PathKind, PlanObserver, Progress, ShapeRecord};
 use dlo_planner::rod::model::Model;
 use pyo3::prelude::*;
@@ -15,6 +16,23 @@ pub(crate) struct PyObserver {
     pub(crate) error: Option<PyErr>,
     /// The callback asked to stop.
     pub(crate) stop: bool,
+    /// The planned shape at each replay step: `k` and its positions at the mesh boundaries.
+    pub(crate) planned: Vec<(f64, Vec<[f64; 3]>)>,
+    /// The replayed shape at each replay step, likewise.
+    pub(crate) replayed: Vec<(f64, Vec<[f64; 3]>)>,
+}
+
+impl PyObserver {
+    pub(crate) fn new(log: Option<PlanLog>, callback: Option<Py<PyAny>>) -> Self {
+        PyObserver {
+            log,
+            callback,
+            error: None,
+            stop: false,
+            planned: Vec::new(),
+            replayed: Vec::new(),
+        }
+    }
 }
 
 impl PyObserver {
@@ -52,6 +70,11 @@ impl PlanObserver for PyObserver {
     fn shape(&mut self, model: &Model, r: &ShapeRecord) {
         if let Some(l) = &mut self.log {
             l.shape(model, r);
+        }
+        match r.kind {
+            PathKind::Optimal => self.planned.push((r.k, rod_points(model, r.a))),
+            PathKind::Feasible => self.replayed.push((r.k, rod_points(model, r.a))),
+            _ => {}
         }
         if r.kind == PathKind::Feasible {
             self.call("replay", |d| {

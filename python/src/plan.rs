@@ -93,14 +93,10 @@ impl Run {
             Some(dir) => Some(crate::logs::open(dir, &self.name)?),
             None => None,
         };
-        let mut obs = PyObserver {
-            log: log
-                .as_ref()
-                .map(|(w, _)| PlanLog::new(w.clone(), self.obstacles.clone())),
-            callback: self.progress,
-            error: None,
-            stop: false,
-        };
+        let plan_log = log
+            .as_ref()
+            .map(|(w, _)| PlanLog::new(w.clone(), self.obstacles.clone()));
+        let mut obs = PyObserver::new(plan_log, self.progress);
         let mut result = py.detach(|| planner.run(&mut obs));
         result.timing_s.endpoints = self.endpoints_s;
         if let Some([v, w]) = self.speeds {
@@ -131,6 +127,15 @@ impl Run {
         let value = serde_json::to_value(&report).expect("report serialises");
         let text = serde_json::to_string(&value).expect("report serialises");
         let class = py.import("dlo_planner.results")?.getattr("Plan")?;
-        Ok(class.call1((text,))?.unbind())
+        let (planned, replayed) = (shapes(obs.planned), shapes(obs.replayed));
+        Ok(class.call1((text, planned, replayed))?.unbind())
     }
+}
+
+/// Shapes in increasing `k` as `(k, flat positions)` for the Python `Shapes` class.
+fn shapes(mut rows: Vec<(f64, Vec<[f64; 3]>)>) -> (Vec<f64>, Vec<f64>) {
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let k = rows.iter().map(|r| r.0).collect();
+    let x = rows.into_iter().flat_map(|r| r.1).flatten().collect();
+    (k, x)
 }

@@ -102,3 +102,44 @@ def test_an_unwritable_log_leaves_nothing(tmp_path):
     with pytest.raises(OSError):
         dlo.Case.load(CASES / "pinned_buckling_080.json").solve(log_dir=blocker / "logs")
     assert list(tmp_path.iterdir()) == [blocker]
+
+
+def test_hostile_values_raise_input_errors_never_panics():
+    # Random NaN, infinite, huge and negative arguments to every entry point (fixed seed):
+    # each call returns a result or raises InputError (TypeError / OverflowError for values
+    # Python cannot convert), never a Rust panic.
+    import random
+
+    rng = random.Random(7)
+    values = [0.0, -1.0, 1e-300, 1e300, float("nan"), float("inf"), -float("inf"), 0.5, 2.0]
+    v = lambda: rng.choice(values)  # noqa: E731
+    few = {"max_outer": 3, "max_inner": 3}
+    rods = [dlo.Rod(1.0, 1.0), dlo.Rod(1.0, 1.0, torsional_rigidity=0.8)]
+
+    def angles(r):
+        return [v() for _ in range(3 if r.spatial else 1)]
+
+    calls = [
+        lambda r: dlo.StaticProblem(r).clamp(v(), [v(), v(), v()], angles(r)).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).fix_point(v(), [v(), v(), v()]).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).load(v(), [v(), 0.0, v()], [v(), v(), v()]).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).obstacle(dlo.Obstacle.ball("b", 0.1, [v(), 0, v()]), v()).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).orientation(v(), phi=v(), theta=v()).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).position(v(), at_least={"x": v()}).solve(settings=few),
+        lambda r: dlo.StaticProblem(r).evaluate([v()] * dlo.StaticProblem(r).coefficients),
+        lambda r: dlo.StaticProblem(r).solve(settings={"rho_initial": v(), "perturbation": v()}),
+        lambda r: dlo.Rod(v(), v(), torsional_rigidity=v(), weight_per_length=v(), radius=v()),
+        lambda r: dlo.StaticProblem(r, base=[v(), v(), v()]).solve(settings=few, points=rng.choice([0, 1, 2])),
+        lambda r: dlo.End.pose([v(), v(), v()], quaternion=[v(), v(), v(), v()]),
+        lambda r: dlo.plan(
+            dlo.StaticProblem(r).clamp(0.0, [0, 0, 0], [0.0] * (3 if r.spatial else 1)),
+            dlo.End.shape([v()] * rng.choice([3, 10, 40])),
+            dlo.End.pose([v(), 0.0, v()], quaternion=[1, 0, 0, 0]),
+        ),
+    ]
+    for _ in range(40):
+        for call in calls:
+            try:
+                call(rng.choice(rods))
+            except (dlo.InputError, TypeError, OverflowError):
+                pass

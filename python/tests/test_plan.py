@@ -27,6 +27,15 @@ def test_a_plan_equals_the_cli_report(dlo_bin, tmp_path, log_dir):
     plan = dlo.Case.load(PAPER).plan(log_dir=log_dir)
     assert strip_files_and_timing(plan.to_dict()) == strip_files_and_timing(cli)
     assert plan.executable and plan.verdict == "executable"
+    # The planned and replayed shapes at the replay's steps: the same k as the trajectory, the
+    # replay's deviation (largest distance of corresponding points) as the report says, and
+    # the planned end at the gripper's pose.
+    assert len(plan.planned) == len(plan.replayed) == len(plan.gripper.k)
+    np.testing.assert_array_equal(plan.planned.k, plan.gripper.k)
+    gap = np.linalg.norm(plan.planned.positions - plan.replayed.positions, axis=2).max()
+    length = 1.0  # the paper's case: L = 1
+    assert gap / length <= plan.replay.max_deviation_over_l * (1 + 1e-9) + 1e-12
+    np.testing.assert_allclose(plan.replayed.positions[:, -1], plan.gripper.positions, atol=1e-9)
     # The trajectory CSV is the CLI's, byte for byte.
     ours = (log_dir / "plan_paper_planar.trajectory.csv").read_bytes()
     assert ours == (tmp_path / "plan_paper_planar.trajectory.csv").read_bytes()
@@ -81,6 +90,7 @@ def test_a_callback_stops_a_plan_and_its_log_is_finished(log_dir):
     held, start, goal = block_problem()
     plan = dlo.plan(held, start, goal, progress=lambda e, info: e == "iteration", log_dir=log_dir, name="python_stopped")
     assert plan.verdict == "interrupted" and not plan.executable
+    assert len(plan.planned) == 0 and plan.planned.positions.shape == (0, 0, 3)
     assert (log_dir / "python_stopped.mcap").stat().st_size > 0
     with pytest.raises(ZeroDivisionError):
         dlo.plan(held, start, goal, progress=lambda e, info: 1 / 0)
@@ -89,23 +99,45 @@ def test_a_callback_stops_a_plan_and_its_log_is_finished(log_dir):
 def test_two_threads_plan_at_once_faster_than_one_after_the_other():
     held, start, goal = block_problem()
     settings = {"starts": 1}
-    dlo.plan(held, start, goal, settings=settings)  # warm
-    t0 = time.perf_counter()
-    serial = [dlo.plan(held, start, goal, settings=settings) for _ in range(2)]
-    t_serial = time.perf_counter() - t0
-    results = [None, None]
+    reference = dlo.plan(held, start, goal, settings=settings)
 
-    def work(i):
-        results[i] = dlo.plan(held, start, goal, settings=settings)
+    # While a plan runs in a thread, this thread keeps running Python: the GIL is released.
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (dlo.plan(held, start, goal, settings=settings), done.set()))
+    spins = 0
+    worker.start()
+    while not done.is_set():
+        spins += 1
+    worker.join()
+    assert spins > 100_000
 
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
-    t0 = time.perf_counter()
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    t_threads = time.perf_counter() - t0
-    assert [r.u_max for r in results] == [r.u_max for r in serial]
+    def serial():
+        return [dlo.plan(held, start, goal, settings=settings) for _ in range(2)]
+
+    def threaded():
+        results = [None, None]
+
+        def work(i):
+            results[i] = dlo.plan(held, start, goal, settings=settings)
+
+        threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        return results
+
+    def best_of(run, n=2):
+        best = float("inf")
+        for _ in range(n):
+            t0 = time.perf_counter()
+            out = run()
+            best = min(best, time.perf_counter() - t0)
+        return best, out
+
+    t_serial, one_after_other = best_of(serial)
+    t_threads, at_once = best_of(threaded)
+    assert [r.u_max for r in at_once] == [r.u_max for r in one_after_other] == [reference.u_max] * 2
     # With the GIL held they would take as long as one after the other; released, the two
-    # cores share them (ideal 0.5).
+    # cores share them (ideally half the time; the fastest of two runs of each).
     assert t_threads < 0.8 * t_serial, (t_threads, t_serial)
