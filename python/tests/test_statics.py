@@ -147,3 +147,37 @@ def test_results_pickle_for_process_pools():
     back = pickle.loads(pickle.dumps(shape))
     assert back == shape and back.energy.total == shape.energy.total
     np.testing.assert_array_equal(back.positions, shape.positions)
+
+
+@pytest.mark.parametrize("case,command", [("pinned_buckling_080", "shape"), ("grasp_a_080", "margin")])
+def test_logs_hold_what_the_cli_logs(dlo_bin, tmp_path, log_dir, case, command):
+    cli_json(dlo_bin, command, str(CASES / f"{case}.json"), "--log-dir", str(tmp_path))
+    loaded = dlo.Case.load(CASES / f"{case}.json")
+    result = loaded.solve(log_dir=log_dir) if command == "shape" else loaded.margin(log_dir=log_dir)
+    assert result.mcap == str(log_dir / f"{case}.mcap")
+
+    def topics(path):
+        found = cli_json(dlo_bin, "inspect", str(path))["topics"]
+        return {t: (v["schema"], v["encoding"], v["messages"]) for t, v in found.items()}
+
+    assert topics(log_dir / f"{case}.mcap") == topics(tmp_path / f"{case}.mcap")
+    assert not [p for p in log_dir.iterdir() if p.name.endswith(".partial")]
+
+
+def _solve_ratio(ratio: float) -> float:
+    shape = pinned_elastica_at(ratio).solve()
+    return [r for r in shape.reactions if r.constraint == "right pin"][0].force[2]
+
+
+def pinned_elastica_at(ratio: float) -> dlo.StaticProblem:
+    rod = dlo.Rod(length=100.0, flexural_rigidity=1.0, radius=0.05)
+    return dlo.StaticProblem(rod).position(100.0, name="right pin", equal={"x": 0.0, "z": 100.0 * ratio})
+
+
+def test_a_process_pool_gives_the_serial_numbers():
+    from concurrent.futures import ProcessPoolExecutor
+
+    ratios = [0.5, 0.6, 0.7, 0.8]
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        pooled = list(pool.map(_solve_ratio, ratios))
+    assert pooled == [_solve_ratio(r) for r in ratios]
