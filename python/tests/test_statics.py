@@ -181,3 +181,18 @@ def test_a_process_pool_gives_the_serial_numbers():
     with ProcessPoolExecutor(max_workers=2) as pool:
         pooled = list(pool.map(_solve_ratio, ratios))
     assert pooled == [_solve_ratio(r) for r in ratios]
+
+
+def test_evaluate_equals_dlo_energy(dlo_bin):
+    cli = cli_json(dlo_bin, "energy", str(CASES / "topology_one_knot_020.json"))
+    ours = dlo.Case.load(CASES / "topology_one_knot_020.json").evaluate().to_dict()
+    for r in (ours, cli):
+        r.pop("timing_s")
+    assert ours == cli
+
+
+def test_margin_progress_reaches_every_limit():
+    seen = []
+    margin = dlo.Case.load(CASES / "grasp_a_080.json").margin(progress=lambda e, info: seen.append((e, info)))
+    assert seen and all(e == "margin" for e, _ in seen)
+    assert seen[-1][1]["done"] == seen[-1][1]["total"] == len(margin.table)
