@@ -6,8 +6,9 @@ elastica (`planning_cases/pinned_buckling_080.json`).
 Both sides run the same compiled code in one process: `_dlo.solve_repeatedly` times, in Rust,
 a solve of the built problem from its natural start with its report (what `dlo shape`
 computes); the Python side times `StaticProblem.solve`, which also builds the problem,
-releases the GIL, and returns the report as a `StaticShape` with NumPy arrays (the shape at
-the quadrature mesh's boundaries by default, or at `points` evenly spaced arc lengths).
+releases the GIL, and returns a `StaticShape`, whose report is parsed and whose shape is sampled
+(at the quadrature mesh's boundaries, or at `points` evenly spaced arc lengths) when first
+read: the second and third rows read the energy and the positions too.
 Each side's median over `--repeats` solves, the fastest of `--rounds` alternating rounds.
 """
 
@@ -27,18 +28,21 @@ def main() -> None:
     rod = dlo.Rod(length=100.0, flexural_rigidity=1.0, radius=0.05)
     problem = dlo.StaticProblem(rod).position(100.0, name="right pin", equal={"x": 0.0, "z": 80.0})
 
-    def python(points):
+    def python(points, read):
         times = []
         for _ in range(args.repeats):
             t0 = time.perf_counter()
-            problem.solve(points=points)
+            shape = problem.solve(points=points)
+            if read:
+                shape.energy.total, shape.positions
             times.append(time.perf_counter() - t0)
         return statistics.median(times)
 
     sides = {
         "Rust": lambda: statistics.median(_dlo.solve_repeatedly(problem, args.repeats)),
-        "Python": lambda: python(None),
-        "Python, points=101": lambda: python(101),
+        "Python": lambda: python(None, False),
+        "+ energy, positions": lambda: python(None, True),
+        "+ 101 points": lambda: python(101, True),
     }
     # The machine's speed drifts: alternate the sides and keep each one's fastest round.
     best = {name: float("inf") for name in sides}

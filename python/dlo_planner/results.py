@@ -90,13 +90,14 @@ class StaticShape(Report):
             tangent ζ).
     """
 
-    def __init__(self, report: str, a, s, positions, frames):
+    def __init__(self, report: str, a, samples):
         super().__init__(report)
-        # Flat lists from the core, made arrays when first read.
-        self._raw = (a, s, positions, frames)
+        # The core's sampler, asked for the arrays when they are first read.
+        self._raw = (a, samples)
 
     def _arrays(self) -> None:
-        a, s, positions, frames = self.__dict__.pop("_raw")
+        a, samples = self.__dict__.pop("_raw")
+        s, positions, frames = samples.arrays()
         self.a = np.asarray(a, dtype=float)
         self.s = np.asarray(s, dtype=float)
         self.positions = np.asarray(positions, dtype=float).reshape(-1, 3)

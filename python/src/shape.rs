@@ -37,7 +37,7 @@ pub(crate) fn solve(py: Python<'_>, mut job: Job, log_dir: Option<&Path>) -> PyR
             value.to_string()
         }
     };
-    result(py, "StaticShape", text, &job.problem, &sol.a, job.points)
+    result(py, "StaticShape", text, job.problem, &sol.a, job.points)
 }
 
 /// Evaluates coefficients `a` without optimising (`dlo energy`).
@@ -55,7 +55,7 @@ pub(crate) fn evaluate(
     let secs = t0.elapsed().as_secs_f64();
     let report = ShapeReport::evaluated(name, &problem, ev, &a, &report_points, secs);
     let text = serde_json::to_string(&report).expect("report serialises");
-    result(py, "StaticShape", text, &problem, &a, points)
+    result(py, "StaticShape", text, problem, &a, points)
 }
 
 fn check_points(p: &StaticProblem, report_points: &[f64], points: Option<usize>) -> PyResult<()> {
@@ -78,23 +78,42 @@ fn check_points(p: &StaticProblem, report_points: &[f64], points: Option<usize>)
 }
 
 /// The Python result class `class_name` of `dlo_planner.results`, from a report and the
-/// shape `a` of `p` sampled at `points` evenly spaced arc lengths.
+/// shape `a` of `p`, sampled when first read (see [`Samples`]).
 pub(crate) fn result(
     py: Python<'_>,
     class_name: &str,
     report: String,
-    p: &StaticProblem,
+    p: StaticProblem,
     a: &[f64],
     points: Option<usize>,
 ) -> PyResult<Py<PyAny>> {
-    let (s, positions, frames) = sampled(p, a, points);
-    // Flat, reshaped by the Python class: far cheaper than nested lists.
-    let positions: Vec<f64> = positions.into_iter().flatten().collect();
-    let frames: Vec<f64> = frames.into_iter().flatten().flatten().collect();
+    let samples = Samples {
+        problem: p,
+        a: a.to_vec(),
+        points,
+    };
     let class = py.import("dlo_planner.results")?.getattr(class_name)?;
-    Ok(class
-        .call1((report, a.to_vec(), s, positions, frames))?
-        .unbind())
+    Ok(class.call1((report, a.to_vec(), samples))?.unbind())
+}
+
+/// A solved shape held for sampling along the rod when a result's arrays are first read, so
+/// that a call that reads only the report does not pay for them.
+#[pyclass(frozen, module = "dlo_planner")]
+pub(crate) struct Samples {
+    problem: StaticProblem,
+    a: Vec<f64>,
+    points: Option<usize>,
+}
+
+#[pymethods]
+impl Samples {
+    /// `(s, positions, frames)` as flat lists (the Python class reshapes them).
+    fn arrays(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (s, positions, frames) = sampled(&self.problem, &self.a, self.points);
+        let positions = positions.into_iter().flatten().collect();
+        let frames = frames.into_iter().flatten().flatten().collect();
+        (s, positions, frames)
+    }
 }
 
 /// Arc lengths, positions and frames (rows; columns ξ, η, ζ) at `n` evenly spaced points,
