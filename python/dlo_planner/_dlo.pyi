@@ -62,6 +62,19 @@ class Obstacle:
     ) -> Obstacle:
         """A cylinder whose axis runs along its local y."""
     @staticmethod
+    def capsule(
+        name: str, a: Vec3, b: Vec3, radius: float, position: Vec3 = ..., rotation: Vec3 = ...
+    ) -> Obstacle:
+        """The points within ``radius`` of the segment from ``a`` to ``b``."""
+    @staticmethod
+    def convex_hull(
+        name: str, points: Sequence[Vec3], position: Vec3 = ..., rotation: Vec3 = ...
+    ) -> Obstacle:
+        """The convex hull of at least 4 points spanning a volume."""
+    @staticmethod
+    def half_space(name: str, normal: Vec3, position: Vec3 = ..., rotation: Vec3 = ...) -> Obstacle:
+        """The points behind the plane through ``position`` with outward ``normal``."""
+    @staticmethod
     def mesh(
         name: str,
         vertices: Sequence[Vec3],

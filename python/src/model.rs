@@ -185,6 +185,54 @@ impl Obstacle {
         Self::placed(name, shape, position, rotation)
     }
 
+    /// A capsule: the points within `radius` of the segment from `a` to `b` (local frame).
+    #[staticmethod]
+    #[pyo3(signature = (name, a, b, radius, position=[0.0; 3], rotation=[0.0; 3]))]
+    fn capsule(
+        name: String,
+        a: [f64; 3],
+        b: [f64; 3],
+        radius: f64,
+        position: [f64; 3],
+        rotation: [f64; 3],
+    ) -> PyResult<Self> {
+        let shape =
+            ObstacleShape::capsule(vec3("a", a)?, vec3("b", b)?, positive("radius", radius)?);
+        Self::placed(name, shape, position, rotation)
+    }
+
+    /// The convex hull of `points` (n × 3, at least 4 spanning a volume).
+    #[staticmethod]
+    #[pyo3(signature = (name, points, position=[0.0; 3], rotation=[0.0; 3]))]
+    fn convex_hull(
+        name: String,
+        points: Vec<[f64; 3]>,
+        position: [f64; 3],
+        rotation: [f64; 3],
+    ) -> PyResult<Self> {
+        for (i, p) in points.iter().enumerate() {
+            vec3(&format!("points[{i}]"), *p)?;
+        }
+        let shape =
+            ObstacleShape::convex_hull(&points).map_err(|m| input_error(Some("points"), m))?;
+        Self::placed(name, shape, position, rotation)
+    }
+
+    /// The half-space behind a plane through `position`: the points `p` with
+    /// `normal · (p − position) ≤ 0` (before `rotation`), e.g. a table.
+    #[staticmethod]
+    #[pyo3(signature = (name, normal, position=[0.0; 3], rotation=[0.0; 3]))]
+    fn half_space(
+        name: String,
+        normal: [f64; 3],
+        position: [f64; 3],
+        rotation: [f64; 3],
+    ) -> PyResult<Self> {
+        let shape =
+            ObstacleShape::half_space(normal).map_err(|m| input_error(Some("normal"), m))?;
+        Self::placed(name, shape, position, rotation)
+    }
+
     /// A closed triangle mesh: `vertices` (n × 3) and `triangles` (m × 3 vertex indices,
     /// counter-clockwise seen from outside), e.g. NumPy arrays.
     #[staticmethod]

@@ -47,7 +47,18 @@ def test_obstacle_fields():
     assert field_of(lambda: dlo.Obstacle.ball("b", 0.1, [0, float("inf"), 0])) == "position[1]"
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     closed = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-    dlo.Obstacle.mesh("tet", v, closed)
+    tet = dlo.Obstacle.mesh("tet", v, closed)
+    hull = dlo.Obstacle.convex_hull("hull", v)
+    for p in ([0.1, 0.1, 0.1], [1.0, 1.0, 1.0], [-0.5, 0.2, 0.2]):
+        assert tet.signed_distance(p)[1] == pytest.approx(hull.signed_distance(p)[1], abs=1e-12)
+    assert field_of(lambda: dlo.Obstacle.convex_hull("flat", v[:3])) == "points"
+    assert field_of(lambda: dlo.Obstacle.convex_hull("flat", np.vstack([v[:3], v[:3] * 2]))) == "points"
+    assert field_of(lambda: dlo.Obstacle.half_space("table", [0, 0, 0])) == "normal"
+    table = dlo.Obstacle.half_space("table", [2.0, 0, 0], position=[-0.3, 0, 0])
+    assert table.signed_distance([0.2, 5.0, -7.0])[1] == pytest.approx(0.5, abs=1e-15)
+    bar = dlo.Obstacle.capsule("bar", [0, -1, 0], [0, 1, 0], 0.1, position=[1.0, 0, 0])
+    assert bar.signed_distance([1.5, 0.3, 0.0])[1] == pytest.approx(0.4, abs=1e-12)
+    assert field_of(lambda: dlo.Obstacle.capsule("bar", [0, 0, 0], [0, 1, 0], -0.1)) == "radius"
     assert field_of(lambda: dlo.Obstacle.mesh("open", v, closed[:3])) == "triangles"
     assert field_of(lambda: dlo.Obstacle.mesh("inside-out", v, closed[:, ::-1])) == "triangles"
     assert field_of(lambda: dlo.Obstacle.mesh("bad index", v, closed + 1)) == "triangles"

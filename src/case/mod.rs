@@ -22,7 +22,7 @@ use crate::statics::StaticOptions;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{StaticProblemBuilder, StaticSettings};
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
+use parry3d_f64::shape::{Ball, Cuboid, Cylinder};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -859,7 +859,7 @@ fn build_shape(
             v.vec3(&format!("{field}.a"), *a)?;
             v.vec3(&format!("{field}.b"), *b)?;
             let r = v.positive(&format!("{field}.radius"), *radius)?;
-            ObstacleShape::Capsule(Capsule::new(vv(*a), vv(*b), r))
+            ObstacleShape::capsule(*a, *b, r)
         }
         ShapeKind::Cylinder {
             half_height,
@@ -873,26 +873,7 @@ fn build_shape(
             for (i, p) in points.iter().enumerate() {
                 v.vec3(&format!("{field}.points[{i}]"), *p)?;
             }
-            if points.len() < 4 {
-                return Err(v.err(
-                    format!("{field}.points"),
-                    "a convex hull needs at least 4 points",
-                ));
-            }
-            if !spans_volume(points) {
-                return Err(v.err(
-                    format!("{field}.points"),
-                    "points are degenerate (coplanar or collinear): no convex hull",
-                ));
-            }
-            let pts: Vec<Vector> = points.iter().map(|p| vv(*p)).collect();
-            let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
-                v.err(
-                    format!("{field}.points"),
-                    "points are degenerate (coplanar?): no convex hull",
-                )
-            })?;
-            ObstacleShape::ConvexHull(Arc::new(hull))
+            ObstacleShape::convex_hull(points).map_err(|m| v.err(format!("{field}.points"), m))?
         }
         ShapeKind::TriangleMesh { obj, scale } => {
             let sc = v.positive(&format!("{field}.scale"), *scale)?;
@@ -925,31 +906,9 @@ fn build_shape(
         }
         ShapeKind::HalfSpace { normal } => {
             let n = v.vec3(&format!("{field}.normal"), *normal)?;
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            if len < 1e-12 {
-                return Err(v.err(format!("{field}.normal"), "must be non-zero"));
-            }
-            ObstacleShape::HalfSpace(n.map(|c| c / len))
+            ObstacleShape::half_space(n).map_err(|m| v.err(format!("{field}.normal"), m))?
         }
     })
-}
-
-/// True when the points are not all (nearly) coplanar: the covariance has three non-negligible
-/// eigenvalues.
-fn spans_volume(points: &[[f64; 3]]) -> bool {
-    let n = points.len() as f64;
-    let mean: Vec<f64> = (0..3)
-        .map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n)
-        .collect();
-    let cov = nalgebra::Matrix3::from_fn(|i, j| {
-        points
-            .iter()
-            .map(|p| (p[i] - mean[i]) * (p[j] - mean[j]))
-            .sum::<f64>()
-            / n
-    });
-    let ev = cov.symmetric_eigenvalues();
-    ev.min() > 1e-12 * ev.max().max(1e-300)
 }
 
 pub(crate) fn coefficients(

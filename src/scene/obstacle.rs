@@ -47,6 +47,42 @@ impl ObstacleShape {
         ObstacleShape::Cylinder(Cylinder::new(half_height, radius))
     }
 
+    /// A capsule: the points within `radius` of the segment from `a` to `b`.
+    pub fn capsule(a: [f64; 3], b: [f64; 3], radius: f64) -> ObstacleShape {
+        let v = |p: [f64; 3]| Vector::new(p[0], p[1], p[2]);
+        ObstacleShape::Capsule(Capsule::new(v(a), v(b), radius))
+    }
+
+    /// The convex hull of `points`; `Err` when there are fewer than 4 or they span no volume.
+    pub fn convex_hull(points: &[[f64; 3]]) -> Result<ObstacleShape, String> {
+        if points.len() < 4 {
+            return Err("a convex hull needs at least 4 points".into());
+        }
+        const DEGENERATE: &str = "points are degenerate (coplanar or collinear): no convex hull";
+        if !spans_volume(points) {
+            return Err(DEGENERATE.into());
+        }
+        let pts: Vec<Vector> = points
+            .iter()
+            .map(|p| Vector::new(p[0], p[1], p[2]))
+            .collect();
+        let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or(DEGENERATE)?;
+        Ok(ObstacleShape::ConvexHull(Arc::new(hull)))
+    }
+
+    /// The half-space `n · p ≤ 0` (local frame) with outward normal along `normal`; `Err`
+    /// when it is (nearly) zero.
+    pub fn half_space(normal: [f64; 3]) -> Result<ObstacleShape, String> {
+        if normal.iter().any(|c| !c.is_finite()) {
+            return Err("must be finite".into());
+        }
+        let len = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+        if len < 1e-12 {
+            return Err("must be non-zero".into());
+        }
+        Ok(ObstacleShape::HalfSpace(normal.map(|c| c / len)))
+    }
+
     /// A closed triangle mesh whose faces wind counter-clockwise seen from outside; `Err` says
     /// what is wrong with it (an index out of range, a hole, inside-out, flat, …), naming
     /// triangles by their index.
@@ -271,6 +307,24 @@ fn project_cuboid(h: Vector, pt: Vector) -> parry3d_f64::query::PointProjection 
         Vector::new(0.0, 0.0, diff.z * sgn.z)
     };
     parry3d_f64::query::PointProjection::new(true, pt + shift)
+}
+
+/// True when the points are not all (nearly) coplanar: the covariance has three non-negligible
+/// eigenvalues.
+fn spans_volume(points: &[[f64; 3]]) -> bool {
+    let n = points.len() as f64;
+    let mean: Vec<f64> = (0..3)
+        .map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n)
+        .collect();
+    let cov = nalgebra::Matrix3::from_fn(|i, j| {
+        points
+            .iter()
+            .map(|p| (p[i] - mean[i]) * (p[j] - mean[j]))
+            .sum::<f64>()
+            / n
+    });
+    let ev = cov.symmetric_eigenvalues();
+    ev.min() > 1e-12 * ev.max().max(1e-300)
 }
 
 #[cfg(test)]
