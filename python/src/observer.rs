@@ -1,6 +1,7 @@
 //! The planner's observer from Python: the MCAP log (as the CLI writes it), a progress
-//! callback, and stopping — when the callback returns `True` or raises, or on Ctrl-C
-//! (`KeyboardInterrupt`), the plan ends as `interrupted` with its log finished.
+//! callback, and stopping — when the callback returns `True` or raises, the plan ends as
+//! `interrupted` with its log finished (Ctrl-C stops it through the planner's stop handle,
+//! see `plan.rs`).
 
 use dlo_planner::output::mcap_log::PlanLog;
 use dlo_planner::output::mcap_log::plan_log::rod_points;
@@ -102,11 +103,6 @@ impl PlanObserver for PyObserver {
     }
 
     fn stop_requested(&mut self) -> bool {
-        if self.error.is_none()
-            && let Err(e) = Python::attach(|py| py.check_signals())
-        {
-            self.error = Some(e);
-        }
         self.stop || self.error.is_some()
     }
 }

@@ -97,7 +97,11 @@ impl Run {
             .as_ref()
             .map(|(w, _)| PlanLog::new(w.clone(), self.obstacles.clone()));
         let mut obs = PyObserver::new(plan_log, self.progress);
-        let mut result = py.detach(|| planner.run(&mut obs));
+        let (result, interrupt) = run_interruptibly(py, planner, &mut obs);
+        let mut result = result;
+        if obs.error.is_none() {
+            obs.error = interrupt;
+        }
         result.timing_s.endpoints = self.endpoints_s;
         if let Some([v, w]) = self.speeds {
             result.trajectory.time_parameterise(v, w);
@@ -138,4 +142,45 @@ fn shapes(mut rows: Vec<(f64, Vec<[f64; 3]>)>) -> (Vec<f64>, Vec<f64>) {
     let k = rows.iter().map(|r| r.0).collect();
     let x = rows.into_iter().flat_map(|r| r.1).flatten().collect();
     (k, x)
+}
+
+/// Runs `planner` on a thread of its own while this one, without the GIL, waits for it and
+/// lets Python handle signals every 20 ms: Ctrl-C (`KeyboardInterrupt`, returned) asks the
+/// planner to stop, so that the run ends as `interrupted` and its log is finished.
+fn run_interruptibly(
+    py: Python<'_>,
+    planner: &Planner,
+    obs: &mut PyObserver,
+) -> (dlo_planner::planner::PlanResult, Option<PyErr>) {
+    use std::sync::atomic::Ordering;
+    use std::sync::mpsc::{RecvTimeoutError, channel};
+    let stop = planner.stop_handle();
+    py.detach(|| {
+        std::thread::scope(|scope| {
+            let (done, finished) = channel();
+            let worker = scope.spawn(move || {
+                let result = planner.run(obs);
+                let _ = done.send(());
+                result
+            });
+            let mut interrupt = None;
+            loop {
+                match finished.recv_timeout(std::time::Duration::from_millis(20)) {
+                    Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
+                    Err(RecvTimeoutError::Timeout) => {
+                        if interrupt.is_none()
+                            && let Err(e) = Python::attach(|py| py.check_signals())
+                        {
+                            stop.store(true, Ordering::Relaxed);
+                            interrupt = Some(e);
+                        }
+                    }
+                }
+            }
+            let result = worker
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (result, interrupt)
+        })
+    })
 }

@@ -141,3 +141,27 @@ def test_two_threads_plan_at_once_faster_than_one_after_the_other():
     # With the GIL held they would take as long as one after the other; released, the two
     # cores share them (ideally half the time; the fastest of two runs of each).
     assert t_threads < 0.8 * t_serial, (t_threads, t_serial)
+
+
+def test_ctrl_c_stops_a_plan_and_finishes_its_log(log_dir):
+    import os
+    import signal
+
+    from mcap.reader import make_reader
+
+    held, start, goal = block_problem()
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            # Four starts one after the other: seconds of work, stopped at 0.3 s.
+            dlo.plan(held, start, goal, settings={"starts": 4, "parallel_starts": 1}, log_dir=log_dir, name="python_ctrl_c")
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - t0 < 1.0
+    log = log_dir / "python_ctrl_c.mcap"
+    with open(log, "rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary is not None and summary.statistics.message_count > 0
+    assert not [p for p in log_dir.iterdir() if p.name.endswith(".partial")]
