@@ -97,8 +97,7 @@ impl Run {
             .as_ref()
             .map(|(w, _)| PlanLog::new(w.clone(), self.obstacles.clone()));
         let mut obs = PyObserver::new(plan_log, self.progress);
-        let (result, interrupt) = run_interruptibly(py, planner, &mut obs);
-        let mut result = result;
+        let (mut result, interrupt) = run_interruptibly(py, planner, &mut obs);
         if obs.error.is_none() {
             obs.error = interrupt;
         }
@@ -128,8 +127,7 @@ impl Run {
         if let Some(e) = obs.error {
             return Err(e);
         }
-        let value = serde_json::to_value(&report).expect("report serialises");
-        let text = serde_json::to_string(&value).expect("report serialises");
+        let text = serde_json::to_string(&report).expect("report serialises");
         let class = py.import("dlo_planner.results")?.getattr("Plan")?;
         let (planned, replayed) = (shapes(obs.planned), shapes(obs.replayed));
         Ok(class.call1((text, planned, replayed))?.unbind())
