@@ -3,7 +3,7 @@
 
 use crate::errors::{build_error, settings_error};
 use crate::model::{StaticProblem, static_settings};
-use dlo_planner::grasp::{Grasp, GraspProblem, GraspSettings};
+use dlo_planner::grasp::{Grasp, GraspProblem, GraspSettings, MarginReport};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -68,9 +68,12 @@ pub(crate) fn margin(
     if let Some(e) = raised.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
     }
-    let mut value = serde_json::to_value(&margin).expect("margin serialises");
-    value["case"] = name.into();
-    value["timing_s"] = secs.into();
+    let mut report = MarginReport {
+        case: name,
+        margin: &margin,
+        mcap: None,
+        timing_s: secs,
+    };
     if let Some(dir) = log_dir {
         let (w, path) = crate::logs::open(dir, name)?;
         let p = &grasp.base;
@@ -84,9 +87,9 @@ pub(crate) fn margin(
         let closed = crate::logs::close(&w, &path);
         logged.map_err(|e| crate::errors::output_error(&path, dlo_planner::error::causes(&e)))?;
         closed?;
-        value["mcap"] = path.display().to_string().into();
+        report.mcap = Some(path.display().to_string());
     }
-    let text = serde_json::to_string(&value).expect("report serialises");
+    let text = serde_json::to_string(&report).expect("report serialises");
     let class = py.import("dlo_planner.results")?.getattr("Margin")?;
     Ok(class.call1((text,))?.unbind())
 }

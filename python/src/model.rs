@@ -1,7 +1,8 @@
 //! The domain types: a rod, obstacles, a static problem (a builder held open so that Python
 //! code can add to it), and the controlled end's start and goal.
 
-use crate::errors::{build_error, input_error};
+use crate::errors::{build_error, input_error, settings_error};
+use dlo_planner::error::SettingsError;
 use dlo_planner::rod::basis::BasisKind;
 use dlo_planner::rod::layout::Layout;
 use dlo_planner::rod::model::Discretisation;
@@ -11,22 +12,11 @@ use pyo3::prelude::*;
 use std::sync::Arc;
 
 fn finite(field: &str, x: f64) -> PyResult<f64> {
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(input_error(Some(field), format!("must be finite, got {x}")))
-    }
+    SettingsError::finite(field, x).map_err(settings_error)
 }
 
 fn positive(field: &str, x: f64) -> PyResult<f64> {
-    if finite(field, x)? > 0.0 {
-        Ok(x)
-    } else {
-        Err(input_error(
-            Some(field),
-            format!("must be positive, got {x}"),
-        ))
-    }
+    SettingsError::positive(field, x).map_err(settings_error)
 }
 
 fn vec3(field: &str, v: [f64; 3]) -> PyResult<[f64; 3]> {
@@ -299,20 +289,8 @@ impl StaticProblem {
         base: [f64; 3],
         free_base: bool,
     ) -> PyResult<Self> {
-        for (field, value, max) in [
-            ("basis_pairs", basis_pairs, 32),
-            ("panels", panels, 2000),
-            ("gauss_points", gauss_points, 16),
-            ("samples", samples, 2000),
-        ] {
-            let min = usize::from(field != "basis_pairs");
-            if !(min..=max).contains(&value) {
-                return Err(input_error(
-                    Some(field),
-                    format!("must be in {min}..={max}, got {value}"),
-                ));
-            }
-        }
+        dlo_planner::rod::model::check_sizes(basis_pairs, panels, gauss_points, samples)
+            .map_err(settings_error)?;
         let kind = match basis {
             "paper" => BasisKind::Paper,
             "legendre" => BasisKind::Legendre,
@@ -652,15 +630,6 @@ impl End {
 /// The rotation matrix of a unit quaternion `(w, x, y, z)` (its norm 1 to 1e-6, as in a case
 /// file).
 fn rotation_of(q: [f64; 4]) -> PyResult<[[f64; 3]; 3]> {
-    for (k, c) in q.iter().enumerate() {
-        finite(&format!("quaternion[{k}]"), *c)?;
-    }
-    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-    if (n - 1.0).abs() > 1e-6 {
-        return Err(input_error(
-            Some("quaternion"),
-            format!("must be a unit quaternion [w, x, y, z]: its norm is {n}"),
-        ));
-    }
-    Ok(dlo_planner::planner::trajectory::rotation_of_quaternion(q))
+    dlo_planner::planner::trajectory::rotation_of_unit_quaternion(q)
+        .map_err(|m| input_error(Some("quaternion"), m))
 }

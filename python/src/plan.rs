@@ -55,21 +55,7 @@ pub(crate) fn plan(
 
 /// The validated speed limits of a time parameterisation (`None` without one).
 pub(crate) fn speed_limits(v: Option<f64>, w: Option<f64>) -> PyResult<Option<[f64; 2]>> {
-    let Some(v) = v else { return Ok(None) };
-    let w = w.unwrap_or(f64::INFINITY);
-    if !(v > 0.0 && v.is_finite()) {
-        return Err(crate::errors::input_error(
-            Some("max_speed"),
-            format!("must be a positive finite number, got {v}"),
-        ));
-    }
-    if w.is_nan() || w <= 0.0 {
-        return Err(crate::errors::input_error(
-            Some("max_angular_speed"),
-            format!("must be a positive number, got {w}"),
-        ));
-    }
-    Ok(Some([v, w]))
+    dlo_planner::planner::trajectory::speed_limits(v, w).map_err(crate::errors::settings_error)
 }
 
 /// One run of a ready planner and what to do with it.

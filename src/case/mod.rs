@@ -497,23 +497,8 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         return Err(v.err("rod.radius", format!("must be in [0, L/2), got {radius}")));
     }
     let d = file.discretisation;
-    for (field, value, range) in [
-        ("discretisation.basis_pairs", d.basis_pairs, 0..=32),
-        ("discretisation.panels", d.panels, 1..=2000),
-        ("discretisation.gauss_points", d.gauss_points, 1..=16),
-        ("discretisation.samples", d.samples, 1..=2000),
-    ] {
-        if !range.contains(&value) {
-            return Err(v.err(
-                field,
-                format!(
-                    "must be in {}..={}, got {value}",
-                    range.start(),
-                    range.end()
-                ),
-            ));
-        }
-    }
+    crate::rod::model::check_sizes(d.basis_pairs, d.panels, d.gauss_points, d.samples)
+        .map_err(|e| v.err(format!("discretisation.{}", e.field), e.message))?;
     let warnings = limits::check(&file, &v)?;
     let rod = Rod {
         length: l,

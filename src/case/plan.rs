@@ -103,15 +103,10 @@ fn end_rotation(
         for (i, c) in q.iter().enumerate() {
             v.finite(&format!("plan.{name}.quaternion[{i}]"), *c)?;
         }
-        let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if (n - 1.0).abs() > 1e-6 {
-            return Err(v.err(
-                f("quaternion"),
-                format!("must be a unit quaternion [w, x, y, z]: its norm is {n}"),
-            ));
-        }
+        let matrix = crate::planner::trajectory::rotation_of_unit_quaternion(q)
+            .map_err(|m| v.err(f("quaternion"), m))?;
         return Ok(Some(EndRotation {
-            matrix: crate::planner::trajectory::rotation_of_quaternion(q),
+            matrix,
             written_phi: None,
         }));
     }

@@ -287,6 +287,21 @@ pub struct Margin {
     pub table: Vec<Limit>,
 }
 
+/// A margin's report: what `dlo margin --json` prints (and the Python package returns).
+#[derive(Clone, Debug, Serialize)]
+pub struct MarginReport<'a> {
+    /// Case name.
+    pub case: &'a str,
+    /// The margin.
+    #[serde(flatten)]
+    pub margin: &'a Margin,
+    /// The MCAP log written, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mcap: Option<String>,
+    /// Wall-clock seconds of the margin computation.
+    pub timing_s: f64,
+}
+
 impl Grasp {
     /// The undisturbed grasp's shape (case units, at the model's mesh boundaries).
     pub fn initial_points(&self) -> Vec<[f64; 3]> {

@@ -4,4 +4,4 @@
 pub mod fingers;
 pub mod margin;
 
-pub use margin::{Directions, Grasp, GraspProblem, GraspSettings, Limit, Margin};
+pub use margin::{Directions, Grasp, GraspProblem, GraspSettings, Limit, Margin, MarginReport};

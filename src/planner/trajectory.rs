@@ -58,6 +58,42 @@ pub struct Trajectory {
     pub duration_s: Option<f64>,
 }
 
+/// The speed limits of a time parameterisation ([`Trajectory::time_parameterise`]), checked:
+/// `max_speed` positive and finite (`None`: no time parameterisation), `max_angular_speed`
+/// positive (default unlimited).
+pub fn speed_limits(
+    max_speed: Option<f64>,
+    max_angular_speed: Option<f64>,
+) -> Result<Option<[f64; 2]>, crate::error::SettingsError> {
+    use crate::error::SettingsError;
+    let Some(v) = max_speed else { return Ok(None) };
+    let w = max_angular_speed.unwrap_or(f64::INFINITY);
+    for (field, x, inf_ok) in [("max_speed", v, false), ("max_angular_speed", w, true)] {
+        if !(x > 0.0 && (inf_ok || x.is_finite())) {
+            return Err(SettingsError::new(
+                field,
+                format!("must be a positive finite number, got {x}"),
+            ));
+        }
+    }
+    Ok(Some([v, w]))
+}
+
+/// The rotation of a unit quaternion `(w, x, y, z)`; `Err` names what is wrong when a
+/// component is not finite or the norm is not 1 to 1e-6.
+pub fn rotation_of_unit_quaternion(q: [f64; 4]) -> Result<[[f64; 3]; 3], String> {
+    if let Some(i) = q.iter().position(|c| !c.is_finite()) {
+        return Err(format!("component {i} must be finite, got {}", q[i]));
+    }
+    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if (n - 1.0).abs() > 1e-6 {
+        return Err(format!(
+            "must be a unit quaternion [w, x, y, z]: its norm is {n}"
+        ));
+    }
+    Ok(rotation_of_quaternion(q))
+}
+
 /// Unit quaternion `(w, x, y, z)` of a rotation matrix (rows).
 pub fn quaternion_of(m: [[f64; 3]; 3]) -> [f64; 4] {
     let tr = m[0][0] + m[1][1] + m[2][2];

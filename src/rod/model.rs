@@ -30,6 +30,35 @@ pub struct Discretisation {
     pub gauss_points: usize,
 }
 
+/// Checks the sizes a problem is built with against the ranges a case file allows: basis
+/// pairs 0..=32, panels 1..=2000, Gauss points 1..=16, sample intervals 1..=2000; the error
+/// names the size outside its range (`basis_pairs`, `panels`, `gauss_points`, `samples`).
+pub fn check_sizes(
+    basis_pairs: usize,
+    panels: usize,
+    gauss_points: usize,
+    samples: usize,
+) -> Result<(), crate::error::SettingsError> {
+    for (field, value, range) in [
+        ("basis_pairs", basis_pairs, 0..=32),
+        ("panels", panels, 1..=2000),
+        ("gauss_points", gauss_points, 1..=16),
+        ("samples", samples, 1..=2000),
+    ] {
+        if !range.contains(&value) {
+            return Err(crate::error::SettingsError::new(
+                field,
+                format!(
+                    "must be in {}..={}, got {value}",
+                    range.start(),
+                    range.end()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Default for Discretisation {
     fn default() -> Self {
         Discretisation {

@@ -2,14 +2,7 @@
 
 use super::*;
 
-#[derive(serde::Serialize)]
-pub(crate) struct MarginReport<'a> {
-    case: &'a str,
-    #[serde(flatten)]
-    margin: &'a dlo_planner::grasp::Margin,
-    mcap: String,
-    timing_s: f64,
-}
+use dlo_planner::grasp::MarginReport;
 
 pub(crate) fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) -> ExitCode {
     use std::fmt::Write;
@@ -67,7 +60,7 @@ pub(crate) fn run_margin(path: &Path, json: bool, plot: bool, log_dir: &Path) ->
     let report = MarginReport {
         case: &c.name,
         margin: &margin,
-        mcap: log_path.display().to_string(),
+        mcap: Some(log_path.display().to_string()),
         timing_s: secs,
     };
     if json {

@@ -57,15 +57,10 @@ use dlo_planner::planner::PlanReport;
 
 /// The validated `--max-speed` and `--max-angular-speed` (the latter infinite when absent).
 pub(crate) fn speed_limits(v: Option<f64>, w: Option<f64>) -> Result<Option<[f64; 2]>, ExitCode> {
-    let Some(v) = v else { return Ok(None) };
-    let w = w.unwrap_or(f64::INFINITY);
-    for (name, x, inf_ok) in [("--max-speed", v, false), ("--max-angular-speed", w, true)] {
-        if !(x > 0.0 && (inf_ok || x.is_finite())) {
-            eprintln!("error: {name}: must be a positive finite number, got {x}");
-            return Err(ExitCode::from(EXIT_BAD_INPUT));
-        }
-    }
-    Ok(Some([v, w]))
+    dlo_planner::planner::trajectory::speed_limits(v, w).map_err(|e| {
+        eprintln!("error: --{}: {}", e.field.replace('_', "-"), e.message);
+        ExitCode::from(EXIT_BAD_INPUT)
+    })
 }
 
 pub(crate) fn run_plan(
