@@ -3,6 +3,7 @@
 //!
 //!     cargo run --release --example plan_suite -- --seed 1
 //!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
+//!     cargo run --release --example plan_suite -- --seed 1 --write target/suite   # the case files
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!
@@ -189,6 +190,11 @@ pub struct Outcome {
     pub name: String,
     pub planned: bool,
     pub coincide: bool,
+    /// The verdict is executable: the optimal path coincides with its replay, or the
+    /// replayed equilibria along its trajectory are a confirmed plan.
+    pub executable: bool,
+    /// Executable by the replayed equilibria (not the optimal path itself).
+    pub by_equilibria: bool,
     pub snaps: bool,
     pub seconds: f64,
     pub travel: f64,
@@ -197,6 +203,9 @@ pub struct Outcome {
     pub checked_clearance: Option<(f64, f64)>,
     pub u_max: f64,
     pub deviation: f64,
+    /// The replay's smallest clearance (units of L; infinite without obstacles), whether every
+    /// replay solve converged and every replayed shape is stable.
+    pub replay: (f64, bool, bool),
 }
 
 /// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
@@ -225,6 +234,25 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
+/// The smallest clearance to any obstacle (units of L) of the replayed shapes at the model's
+/// boundary points, and where in k.
+fn replay_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
+    let model = &p.base.model;
+    let l = model.rod.length;
+    let mut worst = (f64::INFINITY, 0.0);
+    for step in &r.replay.steps {
+        for x in &step.positions {
+            for o in &p.obstacles {
+                let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
+                if d / l < worst.0 {
+                    worst = (d / l, step.k);
+                }
+            }
+        }
+    }
+    worst
+}
+
 pub fn run(
     text: &str,
     name: &str,
@@ -245,17 +273,30 @@ pub fn run(
     let r = p.run(&mut Silent);
     let seconds = t0.elapsed().as_secs_f64();
     let planned = r.status == PlanStatus::Planned;
+    let executed = r.executed_path();
     let t = &r.trajectory;
     Some(Outcome {
         name: name.to_string(),
         planned,
         coincide: planned && r.replay.coincide,
+        executable: executed.is_some(),
+        by_equilibria: executed == Some("equilibria"),
         snaps: !r.replay.snaps.is_empty(),
         seconds,
         travel: t.path_length / t.straight_distance.max(1e-12),
-        checked_clearance: planned.then(|| independent_clearance(&p, &r)),
+        checked_clearance: match executed {
+            Some("equilibria") => Some(replay_clearance(&p, &r)),
+            _ => planned.then(|| independent_clearance(&p, &r)),
+        },
         u_max: r.u_max,
         deviation: r.replay.max_deviation_over_l,
+        replay: (
+            r.replay
+                .min_clearance
+                .map_or(f64::INFINITY, |c| c / p.base.model.rod.length),
+            r.replay.all_converged,
+            r.replay.all_stable,
+        ),
     })
 }
 
@@ -272,6 +313,8 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let n = out.len();
     let planned = out.iter().filter(|o| o.planned).count();
     let coincide = out.iter().filter(|o| o.coincide).count();
+    let executable = out.iter().filter(|o| o.executable).count();
+    let by_equilibria = out.iter().filter(|o| o.by_equilibria).count();
     let snaps = out.iter().filter(|o| o.snaps).count();
     let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
     let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
@@ -281,9 +324,10 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
-        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
         pct(planned),
         pct(coincide),
+        pct(executable),
         percentile(&mut times.clone(), 0.5),
         percentile(&mut times, 0.95),
         worst,
@@ -304,6 +348,12 @@ fn main() {
     let n_planar = arg("--planar", 60) as usize;
     let n_spatial = arg("--spatial", 30) as usize;
     let verbose = args.iter().any(|a| a == "--verbose");
+    // `--write DIR`: every generated case file is written there, for `dlo plan DIR/NAME.json`.
+    let write_dir = args
+        .iter()
+        .position(|a| a == "--write")
+        .and_then(|i| args.get(i + 1))
+        .map(std::path::PathBuf::from);
     // `--plan '{"path_terms": 4}'`: planner settings given to every problem (to measure other
     // settings on the same problems); `--case '{"angle_frame": "case"}'`: top-level case
     // fields given to every problem; none by default.
@@ -329,21 +379,29 @@ fn main() {
                 spatial_problem(&mut rng, i)
             };
             i += 1;
+            if let Some(dir) = &write_dir {
+                std::fs::create_dir_all(dir).expect("--write: a directory");
+                std::fs::write(dir.join(format!("{name}.json")), &text).expect("--write: writable");
+            }
             match run(&text, &name, &plan, &top) {
                 Some(o) => {
                     if verbose {
                         eprintln!(
-                            "{:16} planned {:5} coincide {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4}",
+                            "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4} replay clearance {:+.2e} converged {} stable {}",
                             o.name,
                             o.planned,
                             o.coincide,
+                            o.executable,
                             o.snaps,
                             o.u_max,
                             o.deviation,
                             o.travel,
                             o.seconds,
                             o.checked_clearance.map_or(f64::NAN, |c| c.0),
-                            o.checked_clearance.map_or(f64::NAN, |c| c.1)
+                            o.checked_clearance.map_or(f64::NAN, |c| c.1),
+                            o.replay.0,
+                            o.replay.1,
+                            o.replay.2
                         );
                     }
                     results[kind].push(o);
@@ -370,9 +428,9 @@ fn main() {
         }
     );
     println!(
-        "| problems | n | collision-free | coincide with replay | snap | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
+        "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     print!("{}", table("planar", &results[0]));
     print!("{}", table("3D", &results[1]));
 }

@@ -159,8 +159,9 @@ class Shapes:
 
 
 class Plan(Report):
-    """A plan: the report of ``dlo plan --json`` (``verdict``, ``status``, ``u_max``,
-    ``replay``, ``verification``, ``starts``, ``path``, ``trajectory``, …).
+    """A plan: the report of ``dlo plan --json`` (``verdict``, ``executed_path``, ``status``,
+    ``u_max``, ``replay``, ``equilibrium_plan``, ``verification``, ``starts``, ``path``,
+    ``trajectory``, …).
 
     Attributes:
         gripper: the controlled end's trajectory as arrays (:class:`Trajectory`).
@@ -179,7 +180,9 @@ class Plan(Report):
 
     @property
     def executable(self) -> bool:
-        """Whether the replay by the controlled end coincides with the plan."""
+        """Whether the gripper trajectory executes a collision-free plan: the optimal path,
+        whose replay coincides with it, or its replayed equilibria (``executed_path`` says
+        which)."""
         return self._data["verdict"] == "executable"
 
 

@@ -6,6 +6,7 @@
 
 mod clear_samples;
 pub mod endpoints;
+pub mod equilibrium_plan;
 pub mod minimax;
 pub mod observer;
 pub mod orientation;
@@ -31,7 +32,7 @@ use crate::statics::{SolveStatus, StaticOptions, StaticSettings, StaticSolution,
 pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
-use observer::{PathKind, PlanObserver, ShapeRecord};
+use observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
 use replay::{Replay, replay};
 pub use settings::{Optimiser, PlanSettings};
 use std::sync::Arc;
@@ -40,6 +41,7 @@ use verify::fine_model;
 
 pub use result::{PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
 use start::Verified;
+use starts::StartPlan;
 
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
 /// obstacles and self-contact), where its controlled end starts and where it goes.
@@ -357,6 +359,85 @@ fn held_frame(base: &StaticProblem) -> ([f64; 3], bool) {
     (angles, phi_fixed)
 }
 
+/// A plan replayed: its replay, its replayed equilibria as a plan where it is not executable
+/// as it stands, the shapes both computed (logged if it is chosen) and the seconds they took.
+struct Judged {
+    replay: Replay,
+    equilibrium_plan: Option<equilibrium_plan::EquilibriumPlan>,
+    shapes: RecordedShapes,
+    seconds: f64,
+    /// The optimal path coincides with its replay (collision-free and converged), or the
+    /// replayed equilibria are a plan.
+    executable: bool,
+}
+
+impl Judged {
+    /// Nothing replayed (the run was stopped first).
+    fn not_run(tolerance: f64) -> Judged {
+        Judged {
+            replay: Replay::not_run(tolerance),
+            equilibrium_plan: None,
+            shapes: RecordedShapes::default(),
+            seconds: 0.0,
+            executable: false,
+        }
+    }
+}
+
+impl Planner {
+    /// The best of `runs`: collision-free first, then feasible on the samples, then estimated
+    /// to coincide with its replay, then the lower verified `U_max`, the lower sampled maximum,
+    /// the lower index.
+    fn best_of(&self, runs: &[StartPlan]) -> usize {
+        (0..runs.len())
+            .max_by(|&i, &j| {
+                let (a, b) = (&runs[i].plan, &runs[j].plan);
+                self.class(a)
+                    .cmp(&self.class(b))
+                    .then(b.verification.u_max.total_cmp(&a.verification.u_max))
+                    .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
+                    .then(j.cmp(&i))
+            })
+            .expect("at least one start")
+    }
+
+    /// Replays `run`'s plan and, where the plan is not executable as it stands, checks its
+    /// replayed equilibria as a plan; the shapes are kept, not logged.
+    fn judge(&self, run: &StartPlan, observer: &mut dyn PlanObserver) -> Judged {
+        let t = std::time::Instant::now();
+        let path = self.with_terms(run.terms).path();
+        let z = &run.plan.run.z;
+        let mut rec = Recorder::new(observer);
+        let rep = replay(
+            &self.base,
+            &self.start,
+            &path,
+            z,
+            self.settings.replay(),
+            &self.static_options,
+            &mut rec,
+            &self.stop,
+        );
+        let as_planned = run
+            .plan
+            .verification
+            .collision_free(self.collision_tolerance())
+            && run.plan.run.status == AlStatus::Converged
+            && rep.coincide;
+        let equilibrium_plan = (!as_planned && self.settings.equilibrium_plans && !self.stopped())
+            .then(|| self.equilibrium_plan(&path, z, &rep, &mut rec));
+        let executable = !self.stopped()
+            && (as_planned || equilibrium_plan.as_ref().is_some_and(|e| e.executable));
+        Judged {
+            replay: rep,
+            equilibrium_plan,
+            shapes: rec.into_shapes(),
+            seconds: t.elapsed().as_secs_f64(),
+            executable,
+        }
+    }
+}
+
 impl Planner {
     /// Checks `settings` and solves the start and goal shapes of `problem`.
     ///
@@ -561,20 +642,25 @@ impl Planner {
         observer.phase("optimise");
         self.poll(observer);
         let tol = self.collision_tolerance();
-        let runs = self.run_starts(&fine, observer);
-        // The plan is the start whose verified path is best: collision-free first, then feasible
-        // on the samples, then estimated to coincide with its replay, then the lower true U_max,
-        // the lower sampled maximum, the lower index.
-        let best = (0..runs.len())
-            .max_by(|&i, &j| {
-                let (a, b) = (&runs[i].plan, &runs[j].plan);
-                self.class(a)
-                    .cmp(&self.class(b))
-                    .then(b.verification.u_max.total_cmp(&a.verification.u_max))
-                    .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
-                    .then(j.cmp(&i))
-            })
-            .expect("at least one start");
+        // The best plan so far is replayed (its shapes kept, to be logged if it is chosen)
+        // after each group of starts; the starts stop at the first executable one.
+        let mut judged: Vec<(usize, Judged)> = Vec::new();
+        let mut judge = |runs: &[StartPlan], observer: &mut dyn PlanObserver| -> bool {
+            let best = self.best_of(runs);
+            if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
+                return j.executable;
+            }
+            let j = self.judge(&runs[best], observer);
+            let executable = j.executable;
+            judged.push((best, j));
+            executable
+        };
+        let runs = self.run_starts(&fine, observer, &mut judge);
+        // The plan: the executable one if any, else the best by class and U_max.
+        let best = judged
+            .iter()
+            .find(|(_, j)| j.executable)
+            .map_or_else(|| self.best_of(&runs), |(i, _)| *i);
         observer.phase("select");
         let path_terms = runs[best].terms;
         let path = self.with_terms(path_terms).path();
@@ -584,27 +670,18 @@ impl Planner {
             added,
         } = runs[best].plan.clone();
         let chosen = &chosen;
-        let t_plan = t0.elapsed().as_secs_f64();
+        let judged = match judged.into_iter().find(|(i, _)| *i == best) {
+            Some((_, j)) => j,
+            None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
+            None => self.judge(&runs[best], observer),
+        };
+        let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
 
         observer.phase("replay");
-        let t1 = std::time::Instant::now();
-        let interrupted = self.poll(observer);
-        let rep = if interrupted {
-            Replay::not_run(self.settings.coincide_tolerance)
-        } else {
-            replay(
-                &self.base,
-                &self.start,
-                &path,
-                &chosen.z,
-                self.settings.replay(),
-                &self.static_options,
-                observer,
-                &self.stop,
-            )
-        };
-        let interrupted = interrupted || self.stopped();
-        let t_replay = t1.elapsed().as_secs_f64();
+        flush(&judged.shapes, model, observer);
+        let interrupted = self.poll(observer) || self.stopped();
+        let t_replay = judged.seconds;
+        let (rep, equilibrium_plan) = (judged.replay, judged.equilibrium_plan);
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
         let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
         let status = if interrupted {
@@ -657,6 +734,7 @@ impl Planner {
             z: chosen.z.clone(),
             verification: ver,
             replay: rep,
+            equilibrium_plan,
             trajectory,
             timing_s: Timing {
                 endpoints: 0.0,

@@ -97,3 +97,84 @@ pub(crate) fn poll(observer: &mut dyn PlanObserver, stop: &AtomicBool) -> bool {
     }
     stop.load(Ordering::Relaxed)
 }
+
+/// A shape kept by a [`Recorder`].
+#[derive(Clone, Debug)]
+struct Recorded {
+    kind: PathKind,
+    k: f64,
+    a: Vec<f64>,
+    energy: EnergyTerms,
+    clearance: Option<f64>,
+    deviation: Option<f64>,
+    stable: Option<bool>,
+    reactions: Vec<Reaction>,
+    violation: Option<f64>,
+}
+
+/// Keeps the shapes it is told of, to pass them on later ([`Recorder::flush`]) or never, and
+/// asks `inner` whether to stop: a plan judged before it is chosen logs its replay only if it
+/// is chosen.
+pub(crate) struct Recorder<'a> {
+    inner: &'a mut dyn PlanObserver,
+    shapes: Vec<Recorded>,
+}
+
+impl<'a> Recorder<'a> {
+    /// A recorder that asks `inner` whether to stop.
+    pub(crate) fn new(inner: &'a mut dyn PlanObserver) -> Self {
+        Recorder {
+            inner,
+            shapes: Vec::new(),
+        }
+    }
+
+    /// The shapes kept, to pass on with [`flush`].
+    pub(crate) fn into_shapes(self) -> RecordedShapes {
+        RecordedShapes(self.shapes)
+    }
+}
+
+/// Shapes a [`Recorder`] kept.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct RecordedShapes(Vec<Recorded>);
+
+/// Tells `observer` of every shape in `shapes`, in the order they were computed.
+pub(crate) fn flush(shapes: &RecordedShapes, model: &Model, observer: &mut dyn PlanObserver) {
+    for r in &shapes.0 {
+        observer.shape(
+            model,
+            &ShapeRecord {
+                kind: r.kind,
+                k: r.k,
+                a: &r.a,
+                energy: r.energy,
+                clearance: r.clearance,
+                deviation: r.deviation,
+                stable: r.stable,
+                reactions: &r.reactions,
+                violation: r.violation,
+            },
+        );
+    }
+}
+
+impl PlanObserver for Recorder<'_> {
+    fn shape(&mut self, _model: &Model, r: &ShapeRecord) {
+        self.shapes.push(Recorded {
+            kind: r.kind,
+            k: r.k,
+            a: r.a.to_vec(),
+            energy: r.energy,
+            clearance: r.clearance,
+            deviation: r.deviation,
+            stable: r.stable,
+            reactions: r.reactions.to_vec(),
+            violation: r.violation,
+        });
+    }
+
+    fn stop_requested(&mut self) -> bool {
+        self.inner.stop_requested()
+    }
+}

@@ -44,6 +44,12 @@ pub struct ReplayStep {
     /// Total normal force the obstacles exert on the replayed shape (case units): the sum of
     /// its obstacle rows' multipliers. Zero where no obstacle touches it.
     pub contact_force: f64,
+    /// Ritz coefficients of the replayed shape.
+    #[serde(skip)]
+    pub a: Vec<f64>,
+    /// Boundary positions of the replayed shape (dimensionless, `x/L`).
+    #[serde(skip)]
+    pub positions: Vec<[f64; 3]>,
 }
 
 /// Summary of a replay.
@@ -233,6 +239,8 @@ pub fn replay(
             violation: st.sol.max_violation,
             clearance,
             contact_force: contact_force(base, &st.sol),
+            a: st.sol.a.clone(),
+            positions: st.positions.clone(),
         });
         let opt_terms = {
             let mut sh = Shape::default();

@@ -140,7 +140,7 @@ pub struct PlanResult {
     /// Every start that ran.
     pub starts: Vec<StartSummary>,
     /// Starts of the case that did not run: with `parallel_starts` below `starts`, a group of
-    /// starts runs only when no earlier start's plan is estimated to coincide.
+    /// starts runs only while the best plan so far is not executable.
     pub starts_not_run: usize,
     /// Path terms `m` of the plan: the case's `path_terms`, or the fallback count its start
     /// used.
@@ -155,6 +155,10 @@ pub struct PlanResult {
     pub z: Vec<f64>,
     /// Feasibility replay.
     pub replay: Replay,
+    /// Where the optimal path is not executable as it stands (its replay departs or snaps,
+    /// or it collides): the replayed equilibria along its trajectory as a plan, checked and
+    /// confirmed (`null` when the optimal path's replay coincides, or the run was stopped).
+    pub equilibrium_plan: Option<super::equilibrium_plan::EquilibriumPlan>,
     /// The controlled end's pose at every replay step (what a robot holding it follows) and
     /// the held end's pose.
     pub trajectory: super::trajectory::Trajectory,
@@ -165,10 +169,24 @@ pub struct PlanResult {
 }
 
 impl PlanResult {
+    /// What the gripper trajectory executes: `"optimal"`, the optimal path itself (collision-free,
+    /// converged, and its replay coincides), else `"equilibria"`, the replayed equilibria along
+    /// its trajectory (see [`super::equilibrium_plan`]), else nothing.
+    pub fn executed_path(&self) -> Option<&'static str> {
+        if self.status == PlanStatus::Planned && self.replay.coincide {
+            Some("optimal")
+        } else if self.equilibrium_plan.as_ref().is_some_and(|e| e.executable) {
+            Some("equilibria")
+        } else {
+            None
+        }
+    }
+
     /// The verdict: executable, or why not.
     pub fn verdict(&self) -> PlanVerdict {
         match self.status {
             PlanStatus::Interrupted => PlanVerdict::Interrupted,
+            _ if self.executed_path().is_some() => PlanVerdict::Executable,
             PlanStatus::Collision if self.min_clearance.is_none_or(|c| c >= 0.0) => {
                 PlanVerdict::SelfCollision
             }
@@ -200,6 +218,9 @@ pub struct PlanReport<'a> {
     pub case: &'a str,
     /// Executable, or why not.
     pub verdict: PlanVerdict,
+    /// What the gripper trajectory executes when executable: `"optimal"` or `"equilibria"`
+    /// ([`PlanResult::executed_path`]).
+    pub executed_path: Option<&'static str>,
     /// The result.
     #[serde(flatten)]
     pub result: &'a PlanResult,
@@ -224,6 +245,7 @@ impl<'a> PlanReport<'a> {
         PlanReport {
             case,
             verdict: result.verdict(),
+            executed_path: result.executed_path(),
             result,
             start_energy: planner.start.energy.internal(),
             goal_energy: planner.goal.energy.internal(),

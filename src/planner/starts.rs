@@ -1,7 +1,7 @@
 //! Which starts run: groups of `parallel_starts` starts side by side, first with the case's path
-//! terms and then with each of `fallback_path_terms`, until a start's plan is collision-free,
-//! feasible on its samples and estimated to coincide with its replay; and which of the plans is
-//! the plan.
+//! terms and then with each of `fallback_path_terms`, until the best plan so far is executable
+//! (its replay coincides with it, or its replayed equilibria are a plan); and which of the
+//! plans is the plan.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
@@ -54,13 +54,6 @@ pub(super) struct PlanClass {
     pub(super) coincides: bool,
 }
 
-impl PlanClass {
-    /// All three: no later start or fallback can do better before `U_max`.
-    pub(super) fn is_best(self) -> bool {
-        self.collision_free && self.feasible && self.coincides
-    }
-}
-
 impl Planner {
     /// The planner with `terms` path terms and the same settings otherwise: its
     /// [`Planner::path`] is the path of a plan whose `path_terms` is `terms`.
@@ -101,11 +94,12 @@ impl Planner {
     }
 
     /// Runs the starts in groups and the fallback path-term counts (see the module's doc),
-    /// verifying each plan on `fine`.
+    /// verifying each plan on `fine`, until `judge` finds the plans so far good enough.
     pub(super) fn run_starts(
         &self,
         fine: &Model,
         observer: &mut dyn PlanObserver,
+        judge: &mut dyn FnMut(&[StartPlan], &mut dyn PlanObserver) -> bool,
     ) -> Vec<StartPlan> {
         let nk = self.settings.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
@@ -149,7 +143,7 @@ impl Planner {
                 if self.stopped() {
                     break 'attempts;
                 }
-                if runs.iter().any(|r| self.class(&r.plan).is_best()) {
+                if judge(&runs, observer) {
                     break 'attempts;
                 }
             }

@@ -272,7 +272,9 @@ fn paper_replay_coincides_from_other_starts() {
 /// L, the second start does not run, and the replay confirms the estimate (measured equal to
 /// 1e-15: the replay takes the same 41 steps, and the strip stays clear of the block). With
 /// seed 14 the first start's plan is estimated at 2.48 %, so the second start (seed 15) runs and
-/// is chosen; it is the single start of seed 15 bit for bit.
+/// is chosen; it is the single start of seed 15 bit for bit — when only an optimal path that
+/// coincides counts (`"equilibrium_plans": false`). By default the first start's replayed
+/// equilibria are a plan, and the second start does not run.
 #[test]
 fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let (p, r) = paper();
@@ -291,16 +293,26 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
         r.replay.max_deviation_over_l
     );
 
-    let r5 = paper_with(serde_json::json!({ "seed": 14 }));
+    // Seed 14: the first start's plan departs from its replay, whose equilibria are a plan;
+    // the second start does not run.
+    let eq = paper_with(serde_json::json!({ "seed": 14 }));
+    assert_eq!((eq.starts.len(), eq.starts_not_run), (1, 1));
+    assert!(!eq.replay.coincide);
+    assert_eq!(eq.executed_path(), Some("equilibria"));
+    // Only the optimal path as planned counts (`"equilibrium_plans": false`): the second runs.
+    let r5 = paper_with(serde_json::json!({ "seed": 14, "equilibrium_plans": false }));
     assert_eq!(
         (r5.starts.len(), r5.starts_not_run, r5.chosen_start),
         (2, 0, 1)
     );
+    assert_eq!(r5.executed_path(), Some("optimal"));
     let first = r5.starts[0].equilibrium_deviation.expect("measured");
     assert!(first > 0.02, "{first}");
     assert!(r5.starts[1].equilibrium_deviation.expect("measured") <= 0.02);
     assert!(r5.replay.coincide);
-    let six = paper_with(serde_json::json!({ "seed": 15, "starts": 1, "parallel_starts": 1 }));
+    let six = paper_with(serde_json::json!({
+        "seed": 15, "starts": 1, "parallel_starts": 1, "equilibrium_plans": false
+    }));
     assert_eq!(six.path, r5.path);
     assert_eq!(six.u_max.to_bits(), r5.u_max.to_bits());
 }
@@ -334,7 +346,9 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
 /// study: with four terms both starts' plans depart from their replays by 4.8 % of L (their
 /// samples lie that far from their equilibria), so the first start with six terms runs, its
 /// plan is estimated at 1.4 % and coincides (measured 1.39 %), and it is the plan. Without the
-/// fallback the verdict is negative.
+/// fallback the verdict is negative. (Only an optimal path that coincides counts here,
+/// `"equilibrium_plans": false`; by default the first start's replayed equilibria are a plan,
+/// and no other start runs.)
 #[test]
 fn fallback_path_terms_make_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
@@ -347,7 +361,10 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
         });
         Planner::from_case(&c).unwrap().run(&mut Silent)
     };
-    let r = run(serde_json::json!({}));
+    let by_default = run(serde_json::json!({}));
+    assert_eq!(by_default.starts.len(), 1);
+    assert_eq!(by_default.executed_path(), Some("equilibria"));
+    let r = run(serde_json::json!({ "equilibrium_plans": false }));
     assert_eq!(r.status, PlanStatus::Planned);
     let terms: Vec<usize> = r.starts.iter().map(|s| s.path_terms).collect();
     assert_eq!(terms, [4, 4, 6]);
@@ -364,7 +381,7 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
     assert!(r.replay.all_converged && r.replay.all_stable);
     assert!(r.replay.start_deviation_over_l < 1e-6 && r.replay.end_deviation_over_l < 1e-6);
 
-    let without = run(serde_json::json!({ "fallback_path_terms": [] }));
+    let without = run(serde_json::json!({ "fallback_path_terms": [], "equilibrium_plans": false }));
     assert_eq!(without.starts.len(), 2);
     assert!(
         !without.replay.coincide,
@@ -376,10 +393,11 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
 /// Each start is verified and refined before the starts compete, so two starts are as good as
 /// the better of them: with seeds 16–17, start 16's refined plan peaks at 5.39 and is estimated
 /// to depart from its replay (2.48 % of L), while start 17's refined plan peaks at 5.24 and
-/// coincides. The pair keeps start 17's.
+/// coincides. The pair keeps start 17's (when only an optimal path that coincides counts:
+/// by default start 16's replayed equilibria are a plan, and start 17 does not run).
 #[test]
 fn paper_two_starts_keep_the_better_verified_plan() {
-    let r = paper_with(serde_json::json!({ "seed": 16 }));
+    let r = paper_with(serde_json::json!({ "seed": 16, "equilibrium_plans": false }));
     assert_eq!(r.status, PlanStatus::Planned);
     assert_eq!(r.starts.len(), 2);
     assert!(r.starts.iter().all(|s| s.collision_free));

@@ -24,7 +24,9 @@ fn first(generate: fn(&mut Rng, usize) -> String, kind: &str, n: usize) -> Vec<O
 /// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
 /// is called coinciding. Three of the five coincide with
 /// their replay today (`planar_0`, `planar_2`, `spatial_0`), and must keep doing so; the other two
-/// depart (by 8 % and 4 % of L): the suite's shortfall that docs/results.md reports.
+/// depart (by 8 % and 4 % of L). The 3D one's replayed equilibria are an executable plan; the
+/// planar one's are not (a replay on twice as many steps snaps through): the suite's shortfall
+/// that docs/results.md reports.
 #[test]
 fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
     let planar = first(planar_problem, "planar", 3);
@@ -50,5 +52,91 @@ fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
         if ["planar_0", "planar_2", "spatial_0"].contains(&o.name.as_str()) {
             assert!(o.coincide, "{}: departs by {:.4} L", o.name, o.deviation);
         }
+        // Executable as optimised exactly when it coincides; by its replayed equilibria
+        // otherwise (`spatial_1`, whose optimal path departs by 4 %).
+        assert_eq!(o.executable && !o.by_equilibria, o.coincide, "{}", o.name);
+        if o.name == "spatial_1" {
+            assert!(o.executable && o.by_equilibria, "{}", o.name);
+        }
     }
+}
+
+/// The suite's eighth planar problem (seed 1), planned with the defaults: its optimal path is
+/// collision-free but its replay departs by 2.2 % of L, so the plan the gripper executes is the
+/// replayed equilibria along the optimal path's trajectory. Checked independently of the
+/// planner's own checks: every replayed shape is held at the trajectory's pose (its end's
+/// position to 1e-9 L and its frame to 1e-9), the last one is the goal shape (within the 2 %
+/// tolerance), no shape comes closer to an obstacle than the rod's radius on a grid four times
+/// finer in s (−1e-6 L), and the confirmation replay on twice as many steps reached them.
+#[test]
+fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
+    use dlo_planner::case;
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::observer::Silent;
+    use dlo_planner::planner::verify::fine_model;
+    let mut rng = Rng(1);
+    let text = (0..=7)
+        .map(|i| planar_problem(&mut rng, i))
+        .last()
+        .expect("eight problems");
+    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_7.json"))
+        .expect("a generated case");
+    let p = Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(&mut Silent);
+    assert!(!r.replay.coincide, "the optimal path's replay coincides");
+    assert!(r.replay.max_deviation_over_l > r.replay.tolerance);
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    assert!(r.verdict().is_executable());
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none());
+    assert!(e.confirmation_deviation_over_l.expect("confirmed") <= r.replay.tolerance);
+    assert_eq!(e.confirmation_steps, Some(2 * p.settings.replay_steps));
+    let model = &p.base.model;
+    let l = model.rod.length;
+    assert_eq!(r.replay.steps.len(), r.trajectory.poses.len());
+    for (step, pose) in r.replay.steps.iter().zip(&r.trajectory.poses) {
+        assert_eq!(step.k, pose.k);
+        let end = step.positions.last().expect("boundary points");
+        for i in 0..3 {
+            assert!(
+                (end[i] * l - pose.position[i]).abs() <= 1e-9 * l,
+                "k = {}: end {:?} against the pose {:?}",
+                step.k,
+                end,
+                pose.position
+            );
+        }
+        let frame = model.frame_at(&step.a, 1.0);
+        for (row, want) in frame.iter().zip(&pose.rotation) {
+            for (x, y) in row.iter().zip(want) {
+                assert!((x - y).abs() <= 1e-9, "k = {}: frame {frame:?}", step.k);
+            }
+        }
+        assert!(
+            step.converged && step.stable != Some(false),
+            "k = {}",
+            step.k
+        );
+    }
+    // The last shape is the goal's.
+    let last = r.replay.steps.last().expect("steps");
+    let goal = model.evaluate(&p.goal.a).positions;
+    let d = last
+        .positions
+        .iter()
+        .zip(&goal)
+        .map(|(x, y)| (0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    assert!(d <= r.replay.tolerance, "ends {d:.3e} L from the goal");
+    // Clearance on a grid four times finer in s than the model's boundary points.
+    let fine = fine_model(model, 4 * (last.positions.len() - 1), 2);
+    let mut worst = f64::INFINITY;
+    for step in &r.replay.steps {
+        for x in fine.evaluate(&step.a).positions {
+            for o in &p.obstacles {
+                worst = worst.min(o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius);
+            }
+        }
+    }
+    assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
 }

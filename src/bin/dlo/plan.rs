@@ -242,8 +242,16 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "case {}: {} ({}; optimiser {})",
-        r.case, r.verdict, p.status, p.optimiser
+        "case {}: {}{} ({}; optimiser {})",
+        r.case,
+        r.verdict,
+        match r.executed_path {
+            Some("equilibria") => " by the replayed equilibria along the optimal path's trajectory",
+            Some(_) => " as optimised",
+            None => "",
+        },
+        p.status,
+        p.optimiser
     );
     let _ = writeln!(
         o,
@@ -266,7 +274,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             .any(|s| s.path_terms != p.starts[0].path_terms);
         let not_run = if p.starts_not_run > 0 {
             format!(
-                " ({} more not run: a plan is estimated to coincide)",
+                " ({} more not run: an earlier plan is executable)",
                 p.starts_not_run
             )
         } else {
@@ -324,6 +332,23 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             "touches no obstacle".to_string()
         };
         let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
+    }
+    if let Some(e) = &p.equilibrium_plan {
+        let _ = writeln!(
+            o,
+            "  replayed equilibria as the plan: {}; U_max {:.6e} at k = {:.3}{}",
+            match &e.reason {
+                None => "executable".to_string(),
+                Some(why) => format!("not executable ({why})"),
+            },
+            e.u_max,
+            e.k_at_u_max,
+            match (e.confirmation_steps, e.confirmation_deviation_over_l) {
+                (Some(n), Some(d)) =>
+                    format!("; a replay on {n} steps reaches them within {d:.2e} L"),
+                _ => String::new(),
+            }
+        );
     }
     let t = &p.trajectory;
     let _ = writeln!(

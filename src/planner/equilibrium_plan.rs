@@ -1,0 +1,176 @@
+//! The plan the gripper executes when the optimal path's replay departs from it: the
+//! controlled end's trajectory (the optimal path's end poses), with the rod's equilibria along
+//! it — the replay's shapes — as the plan's shapes.
+//!
+//! The optimal path (paper §7) optimises shapes that no end pose need produce; its replay
+//! finds the shapes the end poses do produce. Where that replay converges everywhere, stays
+//! stable, never snaps through, ends on the goal shape and keeps clear of every obstacle
+//! (each replayed shape is a static solve under the obstacles, so it touches them at most),
+//! the trajectory executes a plan whose shapes are those equilibria. A second replay on
+//! twice as many steps confirms that they do not depend on the step: it must reach the same
+//! shapes, within the coincidence tolerance, at every `k` both replays share.
+
+use super::Planner;
+use super::observer::PlanObserver;
+use super::path::DeformationPath;
+use super::replay::{Replay, ReplayOptions, max_distance, replay};
+use serde::Serialize;
+
+/// The replayed equilibria along the optimal path's trajectory, as a plan.
+#[derive(Clone, Debug, Serialize)]
+pub struct EquilibriumPlan {
+    /// The trajectory executes these shapes: every replay solve converged, every shape is
+    /// stable, nothing snaps, the last shape is the goal's, no obstacle is penetrated, and the
+    /// confirmation replay agrees.
+    pub executable: bool,
+    /// Why not, when not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Largest energy of the replayed shapes (case units).
+    pub u_max: f64,
+    /// `k` where it occurs.
+    pub k_at_u_max: f64,
+    /// Smallest obstacle clearance of the shapes of both replays (case units; `None` without
+    /// obstacles); zero where the rod leans on an obstacle.
+    pub min_clearance: Option<f64>,
+    /// Largest total contact force of the obstacles on a replayed shape (case units; zero when
+    /// the rod never touches one), and its `k`.
+    pub max_contact_force: f64,
+    /// `k` of that force.
+    pub k_at_max_contact_force: f64,
+    /// Steps of the confirmation replay (`null` when it did not run).
+    pub confirmation_steps: Option<usize>,
+    /// Largest distance between the two replays' shapes at the `k` they share (fraction of
+    /// `L`; `null` when the confirmation did not run).
+    pub confirmation_deviation_over_l: Option<f64>,
+}
+
+/// An observer that passes on only the question whether to stop: the confirmation replay's
+/// shapes are not logged (the log holds the replay they confirm).
+struct StopOnly<'a>(&'a mut dyn PlanObserver);
+
+impl PlanObserver for StopOnly<'_> {
+    fn stop_requested(&mut self) -> bool {
+        self.0.stop_requested()
+    }
+}
+
+/// What keeps a replay's shapes from being a plan, if anything: the first failing check of
+/// [`EquilibriumPlan::executable`] other than the confirmation.
+fn failure(first: &Replay, collision_tol: f64) -> Option<String> {
+    let ks = |f: &dyn Fn(&super::replay::ReplayStep) -> bool| -> Vec<f64> {
+        first.steps.iter().filter(|s| f(s)).map(|s| s.k).collect()
+    };
+    if first.steps.is_empty() {
+        return Some("the replay did not run".into());
+    }
+    if !first.all_converged {
+        return Some(format!(
+            "replay solves did not converge at k = {:?}",
+            ks(&|s| !s.converged)
+        ));
+    }
+    if !first.snaps.is_empty() {
+        return Some(format!("the replay snaps through at k = {:?}", first.snaps));
+    }
+    if !first.all_stable {
+        return Some(format!(
+            "replayed shapes are unstable at k = {:?}",
+            ks(&|s| s.stable == Some(false))
+        ));
+    }
+    if first.end_deviation_over_l > first.tolerance {
+        return Some(format!(
+            "the replay ends {:.3e} L from the goal shape: the goal pose holds another equilibrium there",
+            first.end_deviation_over_l
+        ));
+    }
+    if let Some(c) = first.min_clearance.filter(|&c| c < -collision_tol) {
+        return Some(format!(
+            "a replayed shape penetrates an obstacle by {:.3e}",
+            -c
+        ));
+    }
+    None
+}
+
+impl Planner {
+    /// The equilibrium plan of `first`, the replay of `path(z)`: checked, and confirmed by a
+    /// replay on twice as many steps (run only when every other check passes).
+    pub(super) fn equilibrium_plan(
+        &self,
+        path: &DeformationPath,
+        z: &[f64],
+        first: &Replay,
+        observer: &mut dyn PlanObserver,
+    ) -> EquilibriumPlan {
+        let (iu, u_max) = first
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (i, s.u_feasible))
+            .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+        let mut plan = EquilibriumPlan {
+            executable: false,
+            reason: failure(first, self.collision_tolerance()),
+            u_max,
+            k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
+            min_clearance: first.min_clearance,
+            max_contact_force: first.max_contact_force,
+            k_at_max_contact_force: first.k_at_max_contact_force,
+            confirmation_steps: None,
+            confirmation_deviation_over_l: None,
+        };
+        if plan.reason.is_some() || self.stopped() {
+            plan.reason.get_or_insert_with(|| "interrupted".into());
+            return plan;
+        }
+        let opts = ReplayOptions {
+            steps: 2 * self.settings.replay_steps,
+            ..self.settings.replay()
+        };
+        let second = replay(
+            &self.base,
+            &self.start,
+            path,
+            z,
+            opts,
+            &self.static_options,
+            &mut StopOnly(observer),
+            &self.stop,
+        );
+        if self.stopped() {
+            plan.reason = Some("interrupted".into());
+            return plan;
+        }
+        // The largest distance between the replays' shapes at the k they share.
+        let mut worst: f64 = 0.0;
+        let mut j = 0;
+        for s in &first.steps {
+            while j < second.steps.len() && second.steps[j].k < s.k - 1e-12 {
+                j += 1;
+            }
+            if let Some(t) = second.steps.get(j).filter(|t| (t.k - s.k).abs() <= 1e-12) {
+                worst = worst.max(max_distance(&s.positions, &t.positions));
+            }
+        }
+        plan.confirmation_steps = Some(opts.steps);
+        plan.confirmation_deviation_over_l = Some(worst);
+        plan.min_clearance = match (first.min_clearance, second.min_clearance) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        plan.reason = failure(&second, self.collision_tolerance())
+            .map(|r| format!("the confirmation replay on {} steps: {r}", opts.steps))
+            .or_else(|| {
+                (worst > first.tolerance).then(|| {
+                    format!(
+                        "the confirmation replay on {} steps reaches shapes {:.3e} L from the replay's",
+                        opts.steps, worst
+                    )
+                })
+            });
+        plan.executable = plan.reason.is_none();
+        plan
+    }
+}
