@@ -20,11 +20,13 @@
 //! replay, whether the replay snaps, the plan time (end solves, plan, verification and
 //! replay), the gripper's path length over the straight-line distance between its ends, and an
 //! independent clearance check of every plan called collision-free on a grid twice as fine in
-//! k as the verification's, at the model's own boundary points (the worst of these is the
-//! "worst false collision-free" of the table: it must be ≥ −1e-6 L).
+//! k as the verification's, at the model's own boundary points, and of every plan executable
+//! by its replayed equilibria at each replayed shape on a grid four times finer in s (the
+//! worst of these is the "worst false collision-free" of the table: it must be ≥ −1e-6 L).
 
 use dlo_planner::case;
 use dlo_planner::planner::observer::Silent;
+use dlo_planner::planner::verify::fine_model;
 use dlo_planner::planner::{PlanResult, PlanStatus, Planner};
 use dlo_planner::rod::kinematics::Shape;
 use std::path::Path;
@@ -234,14 +236,18 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
-/// The smallest clearance to any obstacle (units of L) of the replayed shapes at the model's
-/// boundary points, and where in k.
+/// The smallest clearance to any obstacle (units of L) of the replayed shapes on a grid four
+/// times finer in s than the model's boundary points, and where in k.
 fn replay_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = &p.base.model;
     let l = model.rod.length;
     let mut worst = (f64::INFINITY, 0.0);
+    let Some(first) = r.replay.steps.first() else {
+        return worst;
+    };
+    let fine = fine_model(model, 4 * (first.positions.len() - 1), 2);
     for step in &r.replay.steps {
-        for x in &step.positions {
+        for x in &fine.evaluate(&step.a).positions {
             for o in &p.obstacles {
                 let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
                 if d / l < worst.0 {

@@ -6,7 +6,9 @@
 //! finds the shapes the end poses do produce. Where that replay converges everywhere, stays
 //! stable, never snaps through, ends on the goal shape and keeps clear of every obstacle
 //! (each replayed shape is a static solve under the obstacles, so it touches them at most),
-//! the trajectory executes a plan whose shapes are those equilibria. A second replay on
+//! the trajectory executes a plan whose shapes are those equilibria. Their clearance is
+//! checked on the verification grid in s: a static solve holds its contacts at its own sample
+//! points, and a shape leaning on an obstacle's corner can dip between them. A second replay on
 //! twice as many steps confirms that they do not depend on the step: it must reach the same
 //! shapes, within the coincidence tolerance, at every `k` both replays share.
 
@@ -30,8 +32,8 @@ pub struct EquilibriumPlan {
     pub u_max: f64,
     /// `k` where it occurs.
     pub k_at_u_max: f64,
-    /// Smallest obstacle clearance of the shapes of both replays (case units; `None` without
-    /// obstacles); zero where the rod leans on an obstacle.
+    /// Smallest obstacle clearance of the shapes of both replays on the verification grid in s
+    /// (case units; `None` without obstacles); zero where the rod leans on an obstacle.
     pub min_clearance: Option<f64>,
     /// Largest total contact force of the obstacles on a replayed shape (case units; zero when
     /// the rod never touches one), and its `k`.
@@ -57,7 +59,7 @@ impl PlanObserver for StopOnly<'_> {
 
 /// What keeps a replay's shapes from being a plan, if anything: the first failing check of
 /// [`EquilibriumPlan::executable`] other than the confirmation.
-fn failure(first: &Replay, collision_tol: f64) -> Option<String> {
+fn failure(first: &Replay) -> Option<String> {
     let ks = |f: &dyn Fn(&super::replay::ReplayStep) -> bool| -> Vec<f64> {
         first.steps.iter().filter(|s| f(s)).map(|s| s.k).collect()
     };
@@ -85,13 +87,47 @@ fn failure(first: &Replay, collision_tol: f64) -> Option<String> {
             first.end_deviation_over_l
         ));
     }
-    if let Some(c) = first.min_clearance.filter(|&c| c < -collision_tol) {
-        return Some(format!(
-            "a replayed shape penetrates an obstacle by {:.3e}",
-            -c
-        ));
-    }
     None
+}
+
+/// Whether the shapes of `replay` keep clear of every obstacle and of themselves on the
+/// verification grid in s (the static solves hold their contacts at their own sample points
+/// only, and a shape leaning on a corner can dip between them): the first failure, if any,
+/// and the smallest obstacle clearance (case units).
+fn penetration(
+    planner: &Planner,
+    fine: &crate::rod::model::Model,
+    replay: &Replay,
+) -> (Option<String>, Option<f64>) {
+    let (worst, self_gap) = super::verify::shapes_clearance(
+        fine,
+        &planner.obstacles,
+        planner.has_self_contact(),
+        replay.steps.iter().map(|s| (s.k, s.a.as_slice())),
+    );
+    let tol = planner.collision_tolerance();
+    let deepest = worst
+        .iter()
+        .min_by(|a, b| a.clearance.total_cmp(&b.clearance));
+    let min_clearance = deepest.map(|w| w.clearance);
+    if let Some(w) = deepest.filter(|w| w.clearance < -tol) {
+        return (
+            Some(format!(
+                "a replayed shape comes {:.3e} inside obstacle '{}' at k = {:.4}, s = {:.4} (between the static solve's contact points)",
+                -w.clearance, w.obstacle, w.k, w.s
+            )),
+            min_clearance,
+        );
+    }
+    if let Some((g, k)) = self_gap.filter(|(g, _)| *g < -tol) {
+        return (
+            Some(format!(
+                "a replayed shape crosses itself (gap {g:.3e}) at k = {k:.4}"
+            )),
+            min_clearance,
+        );
+    }
+    (None, min_clearance)
 }
 
 impl Planner {
@@ -112,7 +148,7 @@ impl Planner {
             .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
         let mut plan = EquilibriumPlan {
             executable: false,
-            reason: failure(first, self.collision_tolerance()),
+            reason: failure(first),
             u_max,
             k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
             min_clearance: first.min_clearance,
@@ -121,6 +157,12 @@ impl Planner {
             confirmation_steps: None,
             confirmation_deviation_over_l: None,
         };
+        let fine = super::verify::fine_model(&self.base.model, self.settings.verify_s_samples, 2);
+        if plan.reason.is_none() {
+            let (why, clearance) = penetration(self, &fine, first);
+            plan.reason = why;
+            plan.min_clearance = clearance;
+        }
         if plan.reason.is_some() || self.stopped() {
             plan.reason.get_or_insert_with(|| "interrupted".into());
             return plan;
@@ -156,11 +198,13 @@ impl Planner {
         }
         plan.confirmation_steps = Some(opts.steps);
         plan.confirmation_deviation_over_l = Some(worst);
-        plan.min_clearance = match (first.min_clearance, second.min_clearance) {
+        let (why, clearance) = penetration(self, &fine, &second);
+        plan.min_clearance = match (plan.min_clearance, clearance) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        plan.reason = failure(&second, self.collision_tolerance())
+        plan.reason = failure(&second)
+            .or(why)
             .map(|r| format!("the confirmation replay on {} steps: {r}", opts.steps))
             .or_else(|| {
                 (worst > first.tolerance).then(|| {

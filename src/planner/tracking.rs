@@ -25,14 +25,20 @@ impl Planner {
         tally: &mut Tally,
         al: AlOptions,
     ) -> (usize, usize, Option<f64>) {
-        if self.settings.equilibrium_weight <= 0.0 {
+        if self
+            .settings
+            .tracking_weight(self.base.model.layout.spatial)
+            <= 0.0
+        {
             return (0, 0, None);
         }
         let mut estimate = None;
         let mut failed = false;
         let mut tracking_rounds = 0;
         let mut kept = 0;
-        p.track_weight = self.settings.equilibrium_weight;
+        p.track_weight = self
+            .settings
+            .tracking_weight(self.base.model.layout.spatial);
         // Targets keep the optimiser's safety margin from obstacles.
         let mut inflated = self.base.clone();
         for con in inflated.constraints.iter_mut() {

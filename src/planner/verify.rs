@@ -148,6 +148,79 @@ fn between(
     between(fine, path, z, obstacles, (k, &mid), hi, depth - 1, worst);
 }
 
+/// The fine grid's self-contact chords: 64 through every fourth-or-so boundary, and the pairs
+/// of them at least `2r` apart along the rod (none without self-contact).
+fn self_contact_chords(fine: &Model, self_contact: bool) -> (Vec<usize>, Vec<(usize, usize)>) {
+    let nb = fine.mesh.boundaries.len();
+    let stride = ((nb - 1) / 64).max(1);
+    let chord_pts: Vec<usize> = (0..nb).step_by(stride).collect();
+    let chord_t: Vec<f64> = chord_pts.iter().map(|&b| fine.mesh.boundaries[b]).collect();
+    let pairs = if self_contact {
+        crate::constraints::SelfContactConstraint::new(
+            chord_pts.clone(),
+            &chord_t,
+            2.0 * fine.rod.radius / fine.rod.length,
+        )
+        .pairs
+    } else {
+        Vec::new()
+    };
+    (chord_pts, pairs)
+}
+
+/// The smallest gap `d − 2r` (case units) between the chord `pairs` of a shape with
+/// dimensionless boundary `positions` (`None` without pairs).
+fn self_gap(
+    fine: &Model,
+    chord_pts: &[usize],
+    pairs: &[(usize, usize)],
+    positions: &[[f64; 3]],
+) -> Option<f64> {
+    let (l, r) = (fine.rod.length, fine.rod.radius);
+    pairs
+        .iter()
+        .map(|&(i, j)| {
+            let x = |q: usize| positions[chord_pts[q]].map(|v| v * l);
+            let (_, _, d) = crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
+            d - 2.0 * r
+        })
+        .reduce(f64::min)
+}
+
+/// Clearances of given shapes (not a path) on the fine grid: each obstacle's worst, and the
+/// worst self-contact gap with `self_contact` (`(gap, k)`), over `shapes` (`k` and Ritz
+/// coefficients).
+pub fn shapes_clearance<'a>(
+    fine: &Model,
+    obstacles: &[Arc<Obstacle>],
+    self_contact: bool,
+    shapes: impl IntoIterator<Item = (f64, &'a [f64])>,
+) -> (Vec<ObstacleClearance>, Option<(f64, f64)>) {
+    let (chord_pts, pairs) = self_contact_chords(fine, self_contact);
+    let mut worst: Vec<ObstacleClearance> = obstacles
+        .iter()
+        .map(|o| ObstacleClearance {
+            obstacle: o.name.clone(),
+            clearance: f64::INFINITY,
+            k: 0.0,
+            s: 0.0,
+        })
+        .collect();
+    let mut worst_self: Option<(f64, f64)> = None;
+    let mut shape = Shape::default();
+    for (k, a) in shapes {
+        fine.evaluate_into(a, &mut shape);
+        let g = gaps_at(fine, obstacles, &shape.positions);
+        record(fine, &g.1, k, &mut worst);
+        if let Some(gap) = self_gap(fine, &chord_pts, &pairs, &shape.positions)
+            && worst_self.is_none_or(|(w, _)| gap < w)
+        {
+            worst_self = Some((gap, k));
+        }
+    }
+    (worst, worst_self)
+}
+
 /// Evaluates `path(z)` on `k_samples` uniform values of `k` with the fine model, and between
 /// them wherever a point could reach an obstacle (see [`verify_with`]).
 pub fn verify(
@@ -171,24 +244,8 @@ pub fn verify_with(
     objective: Objective,
     self_contact: bool,
 ) -> Verification {
-    // 64 chords through every fourth-or-so boundary of the fine grid.
-    let nb = fine.mesh.boundaries.len();
-    let stride = ((nb - 1) / 64).max(1);
-    let chord_pts: Vec<usize> = (0..nb).step_by(stride).collect();
-    let chord_t: Vec<f64> = chord_pts.iter().map(|&b| fine.mesh.boundaries[b]).collect();
-    let pairs = if self_contact {
-        crate::constraints::SelfContactConstraint::new(
-            chord_pts.clone(),
-            &chord_t,
-            2.0 * fine.rod.radius / fine.rod.length,
-        )
-        .pairs
-    } else {
-        Vec::new()
-    };
+    let (chord_pts, pairs) = self_contact_chords(fine, self_contact);
     let mut worst_self: Option<(f64, f64)> = None;
-    let l = fine.rod.length;
-    let r = fine.rod.radius;
     let unit = fine.rod.energy_unit();
     let mut a = vec![0.0; path.n()];
     let mut shape = Shape::default();
@@ -218,13 +275,10 @@ pub fn verify_with(
             record(fine, &g.1, k, &mut worst);
             grid.push(g);
         }
-        for &(i, j) in &pairs {
-            let x = |q: usize| shape.positions[chord_pts[q]].map(|v| v * l);
-            let (_, _, d) = crate::constraints::segment_distance(x(i), x(i + 1), x(j), x(j + 1));
-            let gap = d - 2.0 * r;
-            if worst_self.is_none_or(|(g, _)| gap < g) {
-                worst_self = Some((gap, k));
-            }
+        if let Some(gap) = self_gap(fine, &chord_pts, &pairs, &shape.positions)
+            && worst_self.is_none_or(|(g, _)| gap < g)
+        {
+            worst_self = Some((gap, k));
         }
     }
     // Between grid values: a point moving from p to q keeps at least (g(p) + g(q) − |q − p|)/2

@@ -22,11 +22,11 @@ fn first(generate: fn(&mut Rng, usize) -> String, kind: &str, n: usize) -> Vec<O
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
 /// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
-/// is called coinciding. Three of the five coincide with
-/// their replay today (`planar_0`, `planar_2`, `spatial_0`), and must keep doing so; the other two
-/// depart (by 8 % and 4 % of L). The 3D one's replayed equilibria are an executable plan; the
-/// planar one's are not (a replay on twice as many steps snaps through): the suite's shortfall
-/// that docs/results.md reports.
+/// is called coinciding. Two planar problems coincide with their replay (`planar_0`,
+/// `planar_2`), and must keep doing so; the third departs by 8 % of L, and its replayed
+/// equilibria are not a plan (a replay on twice as many steps snaps through): the suite's
+/// shortfall that docs/results.md reports. The 3D plans, untracked by default, depart by 5 %
+/// and 6 %, and their replayed equilibria are the executable plans.
 #[test]
 fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
     let planar = first(planar_problem, "planar", 3);
@@ -49,13 +49,13 @@ fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
         }
     }
     for o in planar.iter().chain(&spatial) {
-        if ["planar_0", "planar_2", "spatial_0"].contains(&o.name.as_str()) {
+        if ["planar_0", "planar_2"].contains(&o.name.as_str()) {
             assert!(o.coincide, "{}: departs by {:.4} L", o.name, o.deviation);
         }
         // Executable as optimised exactly when it coincides; by its replayed equilibria
-        // otherwise (`spatial_1`, whose optimal path departs by 4 %).
+        // otherwise (both 3D problems, whose untracked optimal paths depart by 5 % and 6 %).
         assert_eq!(o.executable && !o.by_equilibria, o.coincide, "{}", o.name);
-        if o.name == "spatial_1" {
+        if o.name.starts_with("spatial") {
             assert!(o.executable && o.by_equilibria, "{}", o.name);
         }
     }
