@@ -148,6 +148,19 @@ fn between(
     between(fine, path, z, obstacles, (k, &mid), hi, depth - 1, worst);
 }
 
+/// Each obstacle's worst clearance before any shape is seen (infinite).
+fn unseen(obstacles: &[Arc<Obstacle>]) -> Vec<ObstacleClearance> {
+    obstacles
+        .iter()
+        .map(|o| ObstacleClearance {
+            obstacle: o.name.clone(),
+            clearance: f64::INFINITY,
+            k: 0.0,
+            s: 0.0,
+        })
+        .collect()
+}
+
 /// The fine grid's self-contact chords: 64 through every fourth-or-so boundary, and the pairs
 /// of them at least `2r` apart along the rod (none without self-contact).
 fn self_contact_chords(fine: &Model, self_contact: bool) -> (Vec<usize>, Vec<(usize, usize)>) {
@@ -197,15 +210,7 @@ pub fn shapes_clearance<'a>(
     shapes: impl IntoIterator<Item = (f64, &'a [f64])>,
 ) -> (Vec<ObstacleClearance>, Option<(f64, f64)>) {
     let (chord_pts, pairs) = self_contact_chords(fine, self_contact);
-    let mut worst: Vec<ObstacleClearance> = obstacles
-        .iter()
-        .map(|o| ObstacleClearance {
-            obstacle: o.name.clone(),
-            clearance: f64::INFINITY,
-            k: 0.0,
-            s: 0.0,
-        })
-        .collect();
+    let mut worst = unseen(obstacles);
     let mut worst_self: Option<(f64, f64)> = None;
     let mut shape = Shape::default();
     for (k, a) in shapes {
@@ -253,15 +258,7 @@ pub fn verify_with(
     let ks: Vec<f64> = (0..k_samples)
         .map(|j| j as f64 / (k_samples - 1) as f64)
         .collect();
-    let mut worst: Vec<ObstacleClearance> = obstacles
-        .iter()
-        .map(|o| ObstacleClearance {
-            obstacle: o.name.clone(),
-            clearance: f64::INFINITY,
-            k: 0.0,
-            s: 0.0,
-        })
-        .collect();
+    let mut worst = unseen(obstacles);
     // Each grid shape's positions (case units) and, per obstacle, every point's surface gap,
     // for the check between grid values below.
     let mut grid: Vec<ShapeGaps> = Vec::with_capacity(k_samples);
