@@ -4,6 +4,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1
 //!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
 //!     cargo run --release --example plan_suite -- --seed 1 --write target/suite   # the case files
+//!     cargo run --release --example plan_suite -- --seed 1 --only 3d   # plan the 3D problems only
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!
@@ -197,6 +198,8 @@ pub struct Outcome {
     pub executable: bool,
     /// Executable by the replayed equilibria (not the optimal path itself).
     pub by_equilibria: bool,
+    /// Why not executable: the verdict, and why the replayed equilibria are not a plan.
+    pub why_not: Option<String>,
     pub snaps: bool,
     pub seconds: f64,
     pub travel: f64,
@@ -259,12 +262,13 @@ fn replay_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
-pub fn run(
+/// The case of a generated problem, with `plan` settings and `top` case fields given.
+fn problem_case(
     text: &str,
     name: &str,
     plan: &serde_json::Value,
     top: &serde_json::Value,
-) -> Option<Outcome> {
+) -> Option<case::Case> {
     let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
     for (key, value) in plan.as_object().into_iter().flatten() {
         v["plan"][key] = value.clone();
@@ -273,7 +277,22 @@ pub fn run(
         v[key] = value.clone();
     }
     let path = Path::new("planning_cases").join(format!("{name}.json"));
-    let c = case::parse(&v.to_string(), &path).ok()?;
+    case::parse(&v.to_string(), &path).ok()
+}
+
+/// Whether a generated problem counts (its start and goal have static shapes), without
+/// planning it.
+fn counts(text: &str, name: &str, plan: &serde_json::Value, top: &serde_json::Value) -> bool {
+    problem_case(text, name, plan, top).is_some_and(|c| Planner::from_case(&c).is_ok())
+}
+
+pub fn run(
+    text: &str,
+    name: &str,
+    plan: &serde_json::Value,
+    top: &serde_json::Value,
+) -> Option<Outcome> {
+    let c = problem_case(text, name, plan, top)?;
     let t0 = Instant::now();
     let p = Planner::from_case(&c).ok()?;
     let r = p.run(&mut Silent);
@@ -287,6 +306,16 @@ pub fn run(
         coincide: planned && r.replay.coincide,
         executable: executed.is_some(),
         by_equilibria: executed == Some("equilibria"),
+        why_not: executed.is_none().then(|| {
+            format!(
+                "{}{}",
+                r.verdict(),
+                r.equilibrium_plan
+                    .as_ref()
+                    .and_then(|e| e.reason.as_ref())
+                    .map_or(String::new(), |w| format!("; equilibria: {w}"))
+            )
+        }),
         snaps: !r.replay.snaps.is_empty(),
         seconds,
         travel: t.path_length / t.straight_distance.max(1e-12),
@@ -372,7 +401,15 @@ fn main() {
             })
     };
     let (plan, top) = (json_arg("--plan"), json_arg("--case"));
+    // `--only planar` or `--only 3d`: the other kind's problems are generated (the stream of
+    // problems stays the same) but not planned.
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .map(|k| if k == "planar" { 0 } else { 1 });
     let mut rng = Rng(seed);
+    let mut skipped = [0usize; 2];
     let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut regenerated = [0usize; 2];
     for (kind, count) in [(0, n_planar), (1, n_spatial)] {
@@ -388,6 +425,17 @@ fn main() {
             if let Some(dir) = &write_dir {
                 std::fs::create_dir_all(dir).expect("--write: a directory");
                 std::fs::write(dir.join(format!("{name}.json")), &text).expect("--write: writable");
+            }
+            if only.is_some_and(|o| o != kind) {
+                if counts(&text, &name, &plan, &top) {
+                    skipped[kind] += 1;
+                    if skipped[kind] == count {
+                        break;
+                    }
+                } else {
+                    regenerated[kind] += 1;
+                }
+                continue;
             }
             match run(&text, &name, &plan, &top) {
                 Some(o) => {
@@ -409,6 +457,9 @@ fn main() {
                             o.replay.1,
                             o.replay.2
                         );
+                        if let Some(why) = &o.why_not {
+                            eprintln!("{:16} not executable: {why}", o.name);
+                        }
                     }
                     results[kind].push(o);
                 }
