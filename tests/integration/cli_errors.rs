@@ -603,6 +603,16 @@ fn plan_prints_documented_json_and_exit_codes() {
         err.contains("snap.json") && err.contains("snap-through"),
         "{err}"
     );
+    // The replayed equilibria were checked as the plan, and the report and the message say
+    // why they are not one.
+    assert_eq!(v["executed_path"], serde_json::Value::Null);
+    let why = v["equilibrium_plan"]["reason"].as_str().expect("a reason");
+    assert_eq!(v["equilibrium_plan"]["executable"], false);
+    assert!(why.contains("snaps through"), "{why}");
+    assert!(
+        err.contains("the replayed equilibria are not a plan either") && err.contains(why),
+        "{err}"
+    );
     log_ok("snap");
 }
 

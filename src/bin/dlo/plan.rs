@@ -167,28 +167,30 @@ pub(crate) fn run_plan(
                 .iter()
                 .min_by(|a, b| a.clearance.total_cmp(&b.clearance));
             eprintln!(
-                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}); {}",
+                "error: {}: no collision-free plan: the verification grid finds clearance {:.3e} (obstacle {} at k = {:.3}, s = {:.4}){}; {}",
                 path.display(),
                 result.min_clearance.unwrap_or(0.0),
                 worst.map_or("?", |o| o.obstacle.as_str()),
                 worst.map_or(0.0, |o| o.k),
                 worst.map_or(0.0, |o| o.s),
+                equilibria_not_a_plan(&result),
                 TRY_COLLISION
             );
             ExitCode::from(EXIT_COLLISION)
         }
         PlanVerdict::NotConverged => {
             eprintln!(
-                "error: {}: the path optimiser did not converge ({:?}, violation {:.2e})",
+                "error: {}: the path optimiser did not converge ({:?}, violation {:.2e}){}",
                 path.display(),
                 result.optimiser,
-                result.violation
+                result.violation,
+                equilibria_not_a_plan(&result)
             );
             ExitCode::from(EXIT_NOT_CONVERGED)
         }
         PlanVerdict::Departs | PlanVerdict::SnapsThrough => {
             eprintln!(
-                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}; {}",
+                "error: {}: the replay by the controlled end does not coincide with the plan: max deviation {:.3} L at k = {:.3} (tolerance {} L){}{}; {}",
                 path.display(),
                 result.replay.max_deviation_over_l,
                 result.replay.k_at_max_deviation,
@@ -198,6 +200,7 @@ pub(crate) fn run_plan(
                 } else {
                     format!(", snap-through at k = {}", snap_list(&result.replay.snaps))
                 },
+                equilibria_not_a_plan(&result),
                 TRY_DEPARTURE
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
@@ -232,6 +235,17 @@ fn unreachable_end(c: &Case, json: bool, end: &str, message: &str) -> ExitCode {
 
 /// What to try when no plan is collision-free (the case file's `plan` fields).
 pub(crate) const TRY_COLLISION: &str = "try plan.swept_clearance: true, more plan.k_samples, more path terms (plan.fallback_path_terms, e.g. [6, 8]) or more plan.starts";
+
+/// Why the replayed equilibria are not a plan either, when they were checked.
+fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
+    result
+        .equilibrium_plan
+        .as_ref()
+        .and_then(|e| e.reason.as_ref())
+        .map_or(String::new(), |why| {
+            format!("; the replayed equilibria are not a plan either: {why}")
+        })
+}
 
 /// What to try when the replay departs from the plan.
 pub(crate) const TRY_DEPARTURE: &str = "try more path terms (plan.fallback_path_terms, e.g. [6, 8]), more plan.starts, or a stronger plan.equilibrium_weight; the replayed path in the log is what the controlled end does";
