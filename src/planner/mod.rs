@@ -34,7 +34,7 @@ use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
 use replay::{Replay, replay};
-pub use settings::{Optimiser, PlanSettings};
+pub use settings::{Optimiser, PlanSettings, Workspace};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
@@ -286,6 +286,41 @@ fn end_shape(
     Ok(sol)
 }
 
+/// Checks that the workspace can be held on `model` (its own axes, `y = 0` inside on a planar
+/// rod) and that the end shapes' controlled ends lie in it.
+fn check_workspace(
+    model: &crate::rod::model::Model,
+    w: &settings::Workspace,
+    ends: [(&'static str, &StaticSolution); 2],
+) -> Result<(), PlanSetupError> {
+    if model.angle_frame().is_some() {
+        return Err(PlanSetupError::Settings(SettingsError::new(
+            "workspace",
+            "needs the rod's angles measured in the case's own axes (\"angle_frame\": \"case\")",
+        )));
+    }
+    if !model.layout.spatial
+        && (w.min[1].is_some_and(|lo| lo > 0.0) || w.max[1].is_some_and(|hi| hi < 0.0))
+    {
+        return Err(PlanSetupError::Settings(SettingsError::new(
+            "workspace",
+            "a planar rod lies in y = 0, which the bounds on y exclude",
+        )));
+    }
+    let l = model.rod.length;
+    for (which, sol) in ends {
+        let x = model.evaluate(&sol.a).positions[model.boundary(1.0)].map(|v| v * l);
+        let out = w.excess(x);
+        if out > 1e-9 * l {
+            return Err(PlanSetupError::End {
+                end: which,
+                message: format!("the end position {x:?} lies {out:.4e} outside plan.workspace"),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Whether the end's position (when every component is given) lies inside an obstacle or
 /// closer to it than the rod's radius and the obstacle's margin allow; says which.
 fn end_inside_obstacle(base: &StaticProblem, end: &End) -> Option<String> {
@@ -418,6 +453,9 @@ impl Planner {
             &mut rec,
             &self.stop,
         );
+        let within = self
+            .workspace_excess(&path, z)
+            .is_none_or(|(e, _)| e <= self.collision_tolerance());
         let as_planned = run
             .plan
             .verification
@@ -427,6 +465,7 @@ impl Planner {
         let equilibrium_plan = (!as_planned && self.settings.equilibrium_plans && !self.stopped())
             .then(|| self.equilibrium_plan(&path, z, &rep, &mut rec));
         let executable = !self.stopped()
+            && within
             && (as_planned || equilibrium_plan.as_ref().is_some_and(|e| e.executable));
         Judged {
             replay: rep,
@@ -501,6 +540,9 @@ impl Planner {
         let start = end_shape(&problem, "start", &start_end, held, &static_options)?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
         let goal = end_shape(&problem, "goal", &goal_end, held, &static_options)?;
+        if let Some(w) = &settings.workspace {
+            check_workspace(model, w, [("start", &start), ("goal", &goal)])?;
+        }
         let (linear_rows, _) = classify(&problem.statics, 0.0);
         Ok(Planner {
             base: problem.statics,
@@ -569,7 +611,10 @@ impl Planner {
 
     /// The optimiser's problem on the samples `ks` (increasing, from 0 to 1).
     pub fn minimax_problem_at(&self, ks: Vec<f64>) -> MinimaxProblem {
-        let (_, blocks) = classify(&self.base, self.safety());
+        let (_, mut blocks) = classify(&self.base, self.safety());
+        if let Some(w) = &self.settings.workspace {
+            blocks.push(self.workspace_rows(w).into());
+        }
         let mut p = MinimaxProblem::new(
             self.base.model.clone(),
             self.path(),
@@ -581,6 +626,60 @@ impl Planner {
         p.set_swept(self.settings.swept_clearance);
         p.set_skip_clear_samples(true);
         p
+    }
+
+    /// The workspace as rows on the controlled end's position, held at every sample: the box
+    /// shrunk by the safety margin (as obstacles are grown by it, so that the end stays inside
+    /// between samples), but never past the start's and goal's own end positions.
+    fn workspace_rows(&self, w: &Workspace) -> crate::constraints::PositionConstraint {
+        use crate::constraints::Bound;
+        let model = &self.base.model;
+        let b = model.boundary(1.0);
+        let ends = [&self.start.a, &self.goal.a].map(|a| model.evaluate(a).positions[b]);
+        let (l, safety) = (model.rod.length, self.safety());
+        let axes: &[usize] = if model.layout.spatial {
+            &[0, 1, 2]
+        } else {
+            &[0, 2]
+        };
+        let mut rows = Vec::new();
+        for &i in axes {
+            if let Some(lo) = w.min[i] {
+                let lowest = ends[0][i].min(ends[1][i]);
+                rows.push((i, Bound::AtLeast((lo / l + safety).min(lowest))));
+            }
+            if let Some(hi) = w.max[i] {
+                let highest = ends[0][i].max(ends[1][i]);
+                rows.push((i, Bound::AtMost((hi / l - safety).max(highest))));
+            }
+        }
+        crate::constraints::PositionConstraint {
+            name: "workspace".into(),
+            boundary: model.boundary(1.0),
+            rows,
+        }
+    }
+
+    /// How far the controlled end of `path(z)` leaves the workspace on the verification grid
+    /// in k (case units), and where: `None` without a workspace.
+    pub fn workspace_excess(&self, path: &DeformationPath, z: &[f64]) -> Option<(f64, f64)> {
+        let w = self.settings.workspace.as_ref()?;
+        let model = &self.base.model;
+        let (l, b) = (model.rod.length, model.boundary(1.0));
+        let nk = self.settings.verify_k_samples;
+        let mut a = vec![0.0; path.n()];
+        let mut shape = Shape::default();
+        let mut worst = (0.0, 0.0);
+        for j in 0..nk {
+            let k = j as f64 / (nk - 1) as f64;
+            path.shape_at(z, k, &mut a);
+            model.evaluate_into(&a, &mut shape);
+            let e = w.excess(shape.positions[b].map(|v| v * l));
+            if e > worst.0 {
+                worst = (e, k);
+            }
+        }
+        Some(worst)
     }
 
     /// Optimises, verifies and replays the plan.
@@ -684,10 +783,19 @@ impl Planner {
         let (rep, equilibrium_plan) = (judged.replay, judged.equilibrium_plan);
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
         let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
+        let workspace =
+            self.workspace_excess(&path, &chosen.z)
+                .map(|(excess, k)| result::WorkspaceCheck {
+                    largest_excess: excess,
+                    k,
+                    within: excess <= tol,
+                });
         let status = if interrupted {
             PlanStatus::Interrupted
         } else if !ver.collision_free(tol) {
             PlanStatus::Collision
+        } else if workspace.as_ref().is_some_and(|w| !w.within) {
+            PlanStatus::OutsideWorkspace
         } else if chosen.status != AlStatus::Converged {
             PlanStatus::NotConverged
         } else {
@@ -735,6 +843,7 @@ impl Planner {
             verification: ver,
             replay: rep,
             equilibrium_plan,
+            workspace,
             trajectory,
             timing_s: Timing {
                 endpoints: 0.0,

@@ -14,6 +14,8 @@ pub enum PlanStatus {
     Planned,
     /// The verification grid finds a collision (e.g. tunnelling between samples).
     Collision,
+    /// The controlled end leaves the workspace on the verification grid.
+    OutsideWorkspace,
     /// The optimiser did not converge (the path may still be collision-free).
     NotConverged,
     /// The run was stopped ([`super::Planner::stop_handle`]): the plan is the best found so
@@ -26,6 +28,7 @@ impl std::fmt::Display for PlanStatus {
         f.write_str(match self {
             PlanStatus::Planned => "planned",
             PlanStatus::Collision => "collision",
+            PlanStatus::OutsideWorkspace => "outside the workspace",
             PlanStatus::NotConverged => "not converged",
             PlanStatus::Interrupted => "interrupted",
         })
@@ -51,6 +54,8 @@ pub enum PlanVerdict {
     ObstacleCollision,
     /// The verification grid finds the rod crossing itself.
     SelfCollision,
+    /// The controlled end leaves the workspace (`plan.workspace`) on the verification grid.
+    OutsideWorkspace,
     /// The path optimiser did not converge.
     NotConverged,
     /// The run was stopped before it finished.
@@ -75,6 +80,7 @@ impl std::fmt::Display for PlanVerdict {
             PlanVerdict::SnapsThrough => "not executable: the replay snaps through",
             PlanVerdict::ObstacleCollision => "collision with an obstacle",
             PlanVerdict::SelfCollision => "the rod crosses itself",
+            PlanVerdict::OutsideWorkspace => "the controlled end leaves the workspace",
             PlanVerdict::NotConverged => "the path optimiser did not converge",
             PlanVerdict::Interrupted => "interrupted",
             PlanVerdict::Unreachable => "no static shape reaches the start or the goal",
@@ -159,6 +165,8 @@ pub struct PlanResult {
     /// or it collides): the replayed equilibria along its trajectory as a plan, checked and
     /// confirmed (`null` when the optimal path's replay coincides, or the run was stopped).
     pub equilibrium_plan: Option<super::equilibrium_plan::EquilibriumPlan>,
+    /// With `plan.workspace`: how far the controlled end leaves it on the verification grid.
+    pub workspace: Option<WorkspaceCheck>,
     /// The controlled end's pose at every replay step (what a robot holding it follows) and
     /// the held end's pose.
     pub trajectory: super::trajectory::Trajectory,
@@ -173,6 +181,9 @@ impl PlanResult {
     /// converged, and its replay coincides), else `"equilibria"`, the replayed equilibria along
     /// its trajectory (see [`super::equilibrium_plan`]), else nothing.
     pub fn executed_path(&self) -> Option<&'static str> {
+        if self.workspace.as_ref().is_some_and(|w| !w.within) {
+            return None;
+        }
         if self.status == PlanStatus::Planned && self.replay.coincide {
             Some("optimal")
         } else if self.equilibrium_plan.as_ref().is_some_and(|e| e.executable) {
@@ -191,12 +202,24 @@ impl PlanResult {
                 PlanVerdict::SelfCollision
             }
             PlanStatus::Collision => PlanVerdict::ObstacleCollision,
+            PlanStatus::OutsideWorkspace => PlanVerdict::OutsideWorkspace,
             PlanStatus::NotConverged => PlanVerdict::NotConverged,
             PlanStatus::Planned if self.replay.coincide => PlanVerdict::Executable,
             PlanStatus::Planned if !self.replay.snaps.is_empty() => PlanVerdict::SnapsThrough,
             PlanStatus::Planned => PlanVerdict::Departs,
         }
     }
+}
+
+/// The controlled end against the workspace, on the verification grid in k.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct WorkspaceCheck {
+    /// The largest distance outside the box (case units; 0 when it stays inside).
+    pub largest_excess: f64,
+    /// `k` where it occurs.
+    pub k: f64,
+    /// Within the collision tolerance (1e-6 L).
+    pub within: bool,
 }
 
 /// Wall-clock times.

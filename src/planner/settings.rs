@@ -71,6 +71,35 @@ pub struct PlanSettings {
     /// [`super::equilibrium_plan`]); `false`: only an optimal path that coincides with its
     /// replay is executable, as in the paper.
     pub equilibrium_plans: bool,
+    /// Bounds on the controlled end's position along the plan (a robot's reach), in case
+    /// units and axes; absent: none.
+    pub workspace: Option<Workspace>,
+}
+
+/// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
+/// component, in case units and axes; a `null` component is unbounded.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Workspace {
+    /// Lower bounds (x, y, z).
+    #[serde(default)]
+    pub min: [Option<f64>; 3],
+    /// Upper bounds (x, y, z).
+    #[serde(default)]
+    pub max: [Option<f64>; 3],
+}
+
+impl Workspace {
+    /// How far `p` (case units) lies outside the box (0 inside).
+    pub fn excess(&self, p: [f64; 3]) -> f64 {
+        (0..3)
+            .map(|i| {
+                let below = self.min[i].map_or(0.0, |lo| lo - p[i]);
+                let above = self.max[i].map_or(0.0, |hi| p[i] - hi);
+                below.max(above).max(0.0)
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 impl Default for PlanSettings {
@@ -99,6 +128,7 @@ impl Default for PlanSettings {
             optimiser: Optimiser::Bfgs,
             swept_clearance: d_swept(),
             equilibrium_plans: true,
+            workspace: None,
         }
     }
 }
@@ -207,6 +237,23 @@ impl PlanSettings {
             return Err(bad("energy_gap_tolerance", "must be non-negative"));
         }
         positive("coincide_tolerance", self.coincide_tolerance)?;
+        if let Some(w) = &self.workspace {
+            for i in 0..3 {
+                for (name, v) in [("min", w.min[i]), ("max", w.max[i])] {
+                    if let Some(v) = v {
+                        finite(&format!("workspace.{name}[{i}]"), v)?;
+                    }
+                }
+                if let (Some(lo), Some(hi)) = (w.min[i], w.max[i])
+                    && lo > hi
+                {
+                    return Err(bad(
+                        format!("workspace.min[{i}]"),
+                        format!("must not exceed workspace.max[{i}] ({hi}), got {lo}"),
+                    ));
+                }
+            }
+        }
         Ok(())
     }
 

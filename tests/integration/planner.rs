@@ -1500,3 +1500,47 @@ fn planner_new_refuses_ill_formed_problems_built_in_code() {
         Some(PlanSetupError::Settings(s)) if s.field == "rho_initial"
     ));
 }
+
+/// `plan.workspace` bounds the controlled end's position: the shipped planar plan swings the
+/// strip's end out to x = 0.62 on its way round the block; bounded to |x| ≤ 0.45 (the start and
+/// goal sit at ±0.4) the plan keeps every gripper pose inside, to 1e-6 L, and its verification
+/// grid says so. A box that excludes the start, or whose bounds cross, is refused, naming it.
+#[test]
+fn workspace_bounds_keep_the_gripper_inside() {
+    let (_, free) = paper();
+    let widest = free
+        .trajectory
+        .poses
+        .iter()
+        .map(|p| p.position[0].abs())
+        .fold(0.0, f64::max);
+    assert!(widest > 0.6, "{widest}");
+    let bounded = |w: serde_json::Value| {
+        let c = shipped_variant("plan_paper_planar.json", |v| v["plan"]["workspace"] = w);
+        Planner::from_case(&c)
+    };
+    let box_x = serde_json::json!({ "min": [-0.45, null, null], "max": [0.45, null, null] });
+    let r = bounded(box_x)
+        .expect("start and goal inside")
+        .run(&mut Silent);
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    let w = r.workspace.expect("checked");
+    assert!(w.within && w.largest_excess <= 1e-6, "{w:?}");
+    for p in &r.trajectory.poses {
+        assert!(
+            p.position[0].abs() <= 0.45 + 1e-6,
+            "k = {}: {:?}",
+            p.k,
+            p.position
+        );
+    }
+    // The start (x = 0.4) outside the box.
+    let narrow = serde_json::json!({ "max": [0.3, null, null] });
+    let err = bounded(narrow)
+        .expect_err("the start lies outside")
+        .to_string();
+    assert!(err.contains("start") && err.contains("workspace"), "{err}");
+    let crossed = serde_json::json!({ "min": [0.5, null, null], "max": [0.45, null, null] });
+    let err = bounded(crossed).expect_err("crossed bounds").to_string();
+    assert!(err.contains("workspace.min[0]"), "{err}");
+}

@@ -178,6 +178,16 @@ pub(crate) fn run_plan(
             );
             ExitCode::from(EXIT_COLLISION)
         }
+        PlanVerdict::OutsideWorkspace => {
+            let w = result.workspace.expect("checked when outside");
+            eprintln!(
+                "error: {}: the controlled end leaves plan.workspace by {:.3e} at k = {:.3}; try wider bounds or other start and goal poses",
+                path.display(),
+                w.largest_excess,
+                w.k
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
         PlanVerdict::NotConverged => {
             eprintln!(
                 "error: {}: the path optimiser did not converge ({:?}, violation {:.2e}){}",
@@ -346,6 +356,19 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             "touches no obstacle".to_string()
         };
         let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
+    }
+    if let Some(w) = &p.workspace {
+        let _ = writeln!(
+            o,
+            "  workspace: {} (largest excess {:.3e} at k = {:.3})",
+            if w.within {
+                "the end stays inside"
+            } else {
+                "the end LEAVES it"
+            },
+            w.largest_excess,
+            w.k
+        );
     }
     if let Some(e) = &p.equilibrium_plan {
         let _ = writeln!(
