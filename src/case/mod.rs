@@ -115,6 +115,20 @@ pub struct DiscretisationSpec {
     pub gauss_points: usize,
     /// Intervals between obstacle/self-contact sample points.
     pub samples: usize,
+    /// Where obstacle contacts are held: `"points"` (the sample points, default) or
+    /// `"chords"` (the polyline through them).
+    pub contact: ContactModel,
+}
+
+/// Where a static solve holds obstacle contacts (`discretisation.contact`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactModel {
+    /// At the sample points: a rod pressed on a corner can dip between them.
+    #[default]
+    Points,
+    /// On the chords between the sample points.
+    Chords,
 }
 
 impl Default for DiscretisationSpec {
@@ -125,6 +139,7 @@ impl Default for DiscretisationSpec {
             panels: 16,
             gauss_points: 4,
             samples: 32,
+            contact: ContactModel::Points,
         }
     }
 }
@@ -540,6 +555,7 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
             gauss_points: d.gauss_points,
         })
         .samples(d.samples)
+        .chord_contacts(d.contact == ContactModel::Chords)
         .base(base)
         .self_contact(file.self_contact);
     for (i, f) in file.forces.iter().enumerate() {

@@ -1,7 +1,17 @@
 //! Non-interference with a rigid obstacle (eq. 16), for a rod of radius `r`:
-//! `c = (r + margin)/L − d(x(s))/L ≤ 0` at every sample point, where `d` is the signed distance
+//! `c = (r + margin)/L − d/L ≤ 0` at every sample point, where `d` is the signed distance
 //! (negative inside). Its gradient is `−n · ∂x/∂a` with `n` the outward normal. The multiplier
 //! `λ ≥ 0` of a row is the contact force magnitude at that sample, pushing along `n`.
+//!
+//! With `chords` (`discretisation.contact: "chords"`; the path optimiser's rows never), `d` is the smallest signed distance over the point and the
+//! half-chords from it towards its neighbouring sample points, so that the rows together keep
+//! the whole polyline through the sample points clear: a rod pressed on an obstacle's corner,
+//! or wrapped round it, no longer dips between its sample points. The row's witness is the
+//! point of the half-chord `x_b + t (x_n − x_b)`, `t ∈ [0, ½]`, nearest the obstacle; its
+//! gradient is `−n ((1 − t) ∂x_b/∂a + t ∂x_n/∂a)` (the distance's derivative along the chord
+//! vanishes at an interior minimum), and its contact force acts there, split between the two
+//! sample points in those proportions. Half-chords that cannot come within the required
+//! clearance plus their own half-length (the distance is 1-Lipschitz) are not searched.
 
 use super::{Adjoint, Rows};
 use crate::optim::Sense;
@@ -15,12 +25,107 @@ use std::sync::Arc;
 pub struct ObstacleConstraint {
     /// The obstacle.
     pub obstacle: Arc<Obstacle>,
-    /// Sample boundaries.
+    /// Sample boundaries, in increasing arc length.
     pub samples: Vec<usize>,
     /// Required clearance `(r + margin)/L`.
     pub clearance: f64,
     /// Rod length `L` (to convert positions).
     pub length: f64,
+    /// Each row also keeps its half-chords to the neighbouring sample points clear (static
+    /// solves); `false`: the point alone (the path optimiser's sampled rows).
+    pub chords: bool,
+}
+
+/// Where a row's distance is smallest: the boundary towards which the witness lies (the row's
+/// own when `t = 0`), the fraction `t ∈ [0, ½]` of the way, and the signed distance and the
+/// normal there (case units).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Witness {
+    pub(crate) towards: usize,
+    pub(crate) t: f64,
+    pub(crate) distance: f64,
+    pub(crate) normal: [f64; 3],
+}
+
+impl ObstacleConstraint {
+    /// The witness of row `j` for dimensionless boundary `positions`.
+    pub(crate) fn witness(&self, positions: &[[f64; 3]], j: usize) -> Witness {
+        let l = self.length;
+        let b = self.samples[j];
+        let x = positions[b].map(|v| v * l);
+        let (d0, n0) = self.obstacle.signed_distance(x);
+        let mut best = Witness {
+            towards: b,
+            t: 0.0,
+            distance: d0,
+            normal: n0,
+        };
+        if !self.chords {
+            return best;
+        }
+        let need = self.clearance * l;
+        for nb in [j.checked_sub(1), Some(j + 1)].into_iter().flatten() {
+            let Some(&bn) = self.samples.get(nb) else {
+                continue;
+            };
+            let y = positions[bn].map(|v| v * l);
+            let e = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+            let half = 0.5 * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+            // The half-chord comes no closer than d0 − half: far from the required clearance,
+            // the point decides.
+            if d0 - half - need > half {
+                continue;
+            }
+            let at = |t: f64| {
+                self.obstacle
+                    .signed_distance([x[0] + t * e[0], x[1] + t * e[1], x[2] + t * e[2]])
+            };
+            let slope = |n: [f64; 3]| n[0] * e[0] + n[1] * e[1] + n[2] * e[2];
+            // The distance along the chord: its minimum over [0, ½] by bisection on the sign
+            // of its derivative `n · e` (convex obstacles: a convex function of t).
+            if slope(n0) >= 0.0 {
+                continue;
+            }
+            let (dh, nh) = at(0.5);
+            let w = if slope(nh) <= 0.0 {
+                (0.5, dh, nh)
+            } else {
+                let (mut lo, mut hi) = (0.0, 0.5);
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    if slope(at(mid).1) < 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let t = 0.5 * (lo + hi);
+                let (d, _) = at(t);
+                // The normals just before and after the minimum, combined so that the result
+                // is orthogonal to the chord: the distance's gradient at a minimum on a kink
+                // (a cuboid's edge), and the normal there where it is smooth.
+                let (dt, eps) = (hi - lo, 1e-7);
+                let (nm, np) = (at((t - eps - dt).max(0.0)).1, at((t + eps + dt).min(0.5)).1);
+                let (sm, sp) = (slope(nm), slope(np));
+                let mu = if sp - sm > 0.0 && sm < 0.0 && sp > 0.0 {
+                    sp / (sp - sm)
+                } else {
+                    0.5
+                };
+                let n: [f64; 3] = std::array::from_fn(|i| mu * nm[i] + (1.0 - mu) * np[i]);
+                (t, d, n)
+            };
+            if w.1 < best.distance {
+                best = Witness {
+                    towards: bn,
+                    t: w.0,
+                    distance: w.1,
+                    normal: w.2,
+                };
+            }
+        }
+        best
+    }
 }
 
 impl Rows for ObstacleConstraint {
@@ -37,24 +142,30 @@ impl Rows for ObstacleConstraint {
         clearances(self, &shape.positions, out);
     }
     fn add_gradient(&self, _m: &Model, _a: &[f64], shape: &Shape, w: &[f64], adj: &mut Adjoint) {
-        for (&wi, &b) in w.iter().zip(&self.samples) {
+        for (j, (&wi, &b)) in w.iter().zip(&self.samples).enumerate() {
             if wi == 0.0 {
                 continue;
             }
-            let x = shape.positions[b].map(|v| v * self.length);
-            let (_, n) = self.obstacle.signed_distance(x);
-            adj.add_pos(b, -wi, n);
+            let wt = self.witness(&shape.positions, j);
+            adj.add_pos(b, -wi * (1.0 - wt.t), wt.normal);
+            if wt.t > 0.0 {
+                adj.add_pos(wt.towards, -wi * wt.t, wt.normal);
+            }
         }
     }
     /// The distance function's Hessian by central differences of its normal (step `1e-6 L`).
     fn add_curvature(&self, m: &Model, _a: &[f64], shape: &Shape, w: &[f64], h: &mut [f64]) {
         let n = m.n();
         let step = 1e-6 * self.length;
-        for (&wi, &b) in w.iter().zip(&self.samples) {
+        for (j, (&wi, &b)) in w.iter().zip(&self.samples).enumerate() {
             if wi == 0.0 {
                 continue;
             }
-            let x = shape.positions[b].map(|v| v * self.length);
+            // At the witness, whose position is (1 − t) x_b + t x_n.
+            let wt = self.witness(&shape.positions, j);
+            let (xb, xn) = (shape.positions[b], shape.positions[wt.towards]);
+            let x: [f64; 3] =
+                std::array::from_fn(|i| ((1.0 - wt.t) * xb[i] + wt.t * xn[i]) * self.length);
             // D = ∂n/∂X (world units); ∇²ₓc = −L D for dimensionless x.
             let mut d = [[0.0; 3]; 3];
             for k in 0..3 {
@@ -70,7 +181,43 @@ impl Rows for ObstacleConstraint {
             if d.iter().all(|r| r.iter().all(|v| v.abs() < 1e-9)) {
                 continue;
             }
-            let jac = m.position_jacobian(shape, b);
+            let mut jac = m.position_jacobian(shape, b);
+            if wt.t > 0.0 {
+                let jn = m.position_jacobian(shape, wt.towards);
+                if wt.t < 0.5 {
+                    // The witness moves along the chord as the ends move: the minimum's
+                    // Hessian loses `v vᵀ / (eᵀ D e)`, with `v` the derivative of the
+                    // distance's slope along the chord with respect to the ends.
+                    let l = self.length;
+                    let e: [f64; 3] = std::array::from_fn(|i| (xn[i] - xb[i]) * l);
+                    let sym = |r: usize, k: usize| 0.5 * (d[r][k] + d[k][r]);
+                    let de: [f64; 3] =
+                        std::array::from_fn(|r| (0..3).map(|k| sym(r, k) * e[k]).sum());
+                    let denom: f64 = (0..3).map(|r| e[r] * de[r]).sum();
+                    if denom > 1e-12 * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) {
+                        let nn = wt.normal;
+                        let vb: [f64; 3] = std::array::from_fn(|r| (1.0 - wt.t) * de[r] - nn[r]);
+                        let vn: [f64; 3] = std::array::from_fn(|r| wt.t * de[r] + nn[r]);
+                        let q: Vec<f64> = (0..n)
+                            .map(|i| (0..3).map(|r| jac[r][i] * vb[r] + jn[r][i] * vn[r]).sum())
+                            .collect();
+                        let scale = wi * l / denom;
+                        for i in 0..n {
+                            let v = scale * q[i];
+                            if v != 0.0 {
+                                for (hv, qj) in h[i * n..(i + 1) * n].iter_mut().zip(&q) {
+                                    *hv += v * qj;
+                                }
+                            }
+                        }
+                    }
+                }
+                for (row, rn) in jac.iter_mut().zip(&jn) {
+                    for (v, vn) in row.iter_mut().zip(rn) {
+                        *v = (1.0 - wt.t) * *v + wt.t * vn;
+                    }
+                }
+            }
             for r in 0..3 {
                 for k in 0..3 {
                     let dk = -wi * self.length * 0.5 * (d[r][k] + d[k][r]);
@@ -98,6 +245,12 @@ crate::kernels::wide::dispatch! {
 /// The rows' values from the positions (compiled twice, see [`crate::kernels::wide`]).
 #[inline(always)]
 fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f64]) {
+    if c.chords {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = c.clearance - c.witness(positions, j).distance / c.length;
+        }
+        return;
+    }
     for (o, &b) in out.iter_mut().zip(&c.samples) {
         let x = positions[b].map(|v| v * c.length);
         let d = c.obstacle.signed_distance_value(x);

@@ -142,6 +142,13 @@ pub fn clearance(p: &StaticProblem, positions: &[[f64; 3]]) -> Option<f64> {
                 let (d, _) = ob.obstacle.signed_distance(x.map(|v| v * l));
                 best = Some(best.map_or(d - r, |b: f64| b.min(d - r)));
             }
+            // With chord contacts, the chords the constraint holds.
+            if ob.chords {
+                for j in 0..ob.samples.len() {
+                    let d = ob.witness(positions, j).distance;
+                    best = Some(best.map_or(d - r, |b: f64| b.min(d - r)));
+                }
+            }
         }
     }
     best
@@ -178,8 +185,11 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Constraint>) 
                 }
             }
             Constraint::Obstacle(ob) => {
+                // The optimiser's sampled rows hold at the sample points (the safety margin
+                // and the verification grid keep what lies between them clear).
                 let mut o = ob.clone();
                 o.clearance += safety;
+                o.chords = false;
                 blocks.push(o.into());
             }
             // x(0) is the fixed base: constant along every path.

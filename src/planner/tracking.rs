@@ -44,6 +44,7 @@ impl Planner {
         for con in inflated.constraints.iter_mut() {
             if let Constraint::Obstacle(ob) = con {
                 ob.clearance += self.safety();
+                ob.chords = false;
             }
         }
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of

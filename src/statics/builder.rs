@@ -78,6 +78,7 @@ pub struct StaticProblemBuilder {
     layout: Layout,
     disc: Discretisation,
     samples: usize,
+    chord_contacts: bool,
     base: [f64; 3],
     frame: Option<[[f64; 3]; 3]>,
     items: Vec<Item>,
@@ -96,6 +97,7 @@ impl StaticProblem {
             layout,
             disc: Discretisation::default(),
             samples: 32,
+            chord_contacts: false,
             base: [0.0; 3],
             frame: None,
             items: Vec::new(),
@@ -117,6 +119,13 @@ impl StaticProblemBuilder {
     /// Intervals between the points checked against obstacles and self-contact (default 32).
     pub fn samples(mut self, n: usize) -> Self {
         self.samples = n;
+        self
+    }
+
+    /// Obstacle contacts held on the chords between sample points, not at the points alone
+    /// (see [`crate::constraints::obstacle`]; default `false`).
+    pub fn chord_contacts(mut self, on: bool) -> Self {
+        self.chord_contacts = on;
         self
     }
 
@@ -486,6 +495,7 @@ impl StaticProblemBuilder {
                     samples: samples.clone(),
                     clearance: (self.rod.radius + margin) / l,
                     length: l,
+                    chords: self.chord_contacts,
                 }
                 .into(),
             );

@@ -67,7 +67,7 @@ pub(crate) fn point_forces(
     lam: &[f64],
 ) -> Option<Vec<(usize, [f64; 3], bool)>> {
     use crate::constraints::*;
-    let (fu, l) = (m.rod.force_unit(), m.rod.length);
+    let fu = m.rod.force_unit();
     match con {
         Constraint::Position(pc) => {
             let mut f = [0.0; 3];
@@ -90,11 +90,14 @@ pub(crate) fn point_forces(
         }
         Constraint::Obstacle(ob) => {
             let mut out = Vec::new();
-            for (&li, &b) in lam.iter().zip(&ob.samples) {
+            // At the row's witness: split between its two sample points in proportion.
+            for (j, (&li, &b)) in lam.iter().zip(&ob.samples).enumerate() {
                 if li > 0.0 {
-                    let x = shape.positions[b].map(|v| v * l);
-                    let (_, n) = ob.obstacle.signed_distance(x);
-                    out.push((b, n.map(|nc| li * nc * fu), true));
+                    let w = ob.witness(&shape.positions, j);
+                    out.push((b, w.normal.map(|nc| (1.0 - w.t) * li * nc * fu), true));
+                    if w.t > 0.0 {
+                        out.push((w.towards, w.normal.map(|nc| w.t * li * nc * fu), true));
+                    }
                 }
             }
             Some(out)

@@ -395,12 +395,17 @@ fn all_constraints(m: &Model) -> Vec<Constraint> {
         Constraint::from(SelfContactConstraint::new(samples.clone(), &ts, 0.9)),
     ];
     for o in shapes {
-        out.push(Constraint::from(ObstacleConstraint {
-            obstacle: o,
-            samples: samples.clone(),
-            clearance: 0.01,
-            length: 2.0,
-        }));
+        // Rows at the points alone, and with their half-chords; a clearance large enough that
+        // the half-chords are searched.
+        for (chords, clearance) in [(false, 0.01), (true, 0.6)] {
+            out.push(Constraint::from(ObstacleConstraint {
+                obstacle: o.clone(),
+                samples: samples.clone(),
+                clearance,
+                length: 2.0,
+                chords,
+            }));
+        }
     }
     out
 }
@@ -508,17 +513,20 @@ fn obstacle_signed_distance_is_negative_inside_and_exact_for_a_ball() {
 
 /// The static problem's Hessian (`∇²V + Σ yᵢ∇²cᵢ`, with the obstacle distance's own curvature)
 /// against central differences of its analytic gradient, on shipped cases covering point loads
-/// and fingers with a free base, a 3D extensible twisted rod, gravity, and a cylinder obstacle.
+/// and fingers with a free base, a 3D extensible twisted rod, gravity, and a cylinder obstacle,
+/// held at points and on chords (whose witnesses move along their chords).
 #[test]
 fn static_hessian_matches_finite_differences() {
-    for name in [
-        "grasp_a_080.json",
-        "extensible_twist_3d.json",
-        "gravity_rho_g_050.json",
-        "plan_cable_around_pillar.json",
+    for (name, contact) in [
+        ("grasp_a_080.json", "points"),
+        ("extensible_twist_3d.json", "points"),
+        ("gravity_rho_g_050.json", "points"),
+        ("plan_cable_around_pillar.json", "points"),
+        ("plan_cable_around_pillar.json", "chords"),
     ] {
-        let path = std::path::Path::new("planning_cases").join(name);
-        let case = dlo_planner::case::load(&path).unwrap();
+        let case = common::shipped_variant(name, |v| {
+            v["discretisation"]["contact"] = contact.into();
+        });
         let mut p = case.problem.clone();
         let m = p.m();
         let mut rng = Lcg(7);
@@ -526,6 +534,9 @@ fn static_hessian_matches_finite_differences() {
         let y: Vec<f64> = (0..m).map(|_| rng.next()).collect();
         assert!(p.has_hessian() && p.hessian_is_exact(&y));
         let worst = common::hessian_fd_error(&mut p, &a, &y);
-        assert!(worst < 1e-5, "{name}: Hessian relative error {worst:e}");
+        assert!(
+            worst < 1e-5,
+            "{name} ({contact}): Hessian relative error {worst:e}"
+        );
     }
 }

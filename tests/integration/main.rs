@@ -7,6 +7,7 @@ mod branches;
 mod clear_samples;
 mod cli_errors;
 mod common;
+mod contacts;
 mod elastica;
 mod golden;
 mod gradients;
