@@ -123,7 +123,7 @@ impl StaticProblemBuilder {
     }
 
     /// Obstacle contacts held on the chords between sample points, not at the points alone
-    /// (see [`crate::constraints::obstacle`]; default `false`).
+    /// (see [`crate::constraints::ObstacleConstraint`]; default `false`).
     pub fn chord_contacts(mut self, on: bool) -> Self {
         self.chord_contacts = on;
         self
