@@ -94,7 +94,8 @@ class Obstacle:
 class StaticProblem:
     """A rod's static problem: conditions at arc lengths, loads, obstacles, self-contact.
     Methods that add to it return the problem, so calls chain. ``basis`` is ``"paper"`` (the
-    paper's ``1, s/L, sin, cos``) or ``"legendre"``."""
+    paper's ``1, s/L, sin, cos``) or ``"legendre"``; ``contact`` is where obstacle contacts are
+    held: ``"points"`` (the sample points) or ``"chords"`` (the chords between them)."""
 
     def __init__(
         self,
@@ -106,6 +107,7 @@ class StaticProblem:
         samples: int = 32,
         base: Vec3 = ...,
         free_base: bool = False,
+        contact: Literal["points", "chords"] = "points",
     ) -> None: ...
     def clamp(self, s: float, position: Vec3, angles: Sequence[float]) -> StaticProblem:
         """Clamps the rod at ``s``: the point at ``position`` and the Euler angles — ``[θ]``

@@ -277,7 +277,7 @@ pub struct StaticProblem {
 #[pymethods]
 impl StaticProblem {
     #[new]
-    #[pyo3(signature = (rod, basis_pairs=4, basis="paper", panels=16, gauss_points=4, samples=32, base=[0.0; 3], free_base=false))]
+    #[pyo3(signature = (rod, basis_pairs=4, basis="paper", panels=16, gauss_points=4, samples=32, base=[0.0; 3], free_base=false, contact="points"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         rod: &Rod,
@@ -288,7 +288,18 @@ impl StaticProblem {
         samples: usize,
         base: [f64; 3],
         free_base: bool,
+        contact: &str,
     ) -> PyResult<Self> {
+        let chords = match contact {
+            "points" => false,
+            "chords" => true,
+            other => {
+                return Err(input_error(
+                    Some("contact"),
+                    format!("must be \"points\" or \"chords\", got {other:?}"),
+                ));
+            }
+        };
         dlo_planner::rod::model::check_sizes(basis_pairs, panels, gauss_points, samples)
             .map_err(settings_error)?;
         let kind = match basis {
@@ -310,6 +321,7 @@ impl StaticProblem {
                 gauss_points,
             })
             .samples(samples)
+            .chord_contacts(chords)
             .base(vec3("base", base)?);
         Ok(StaticProblem {
             builder,

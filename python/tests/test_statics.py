@@ -196,3 +196,28 @@ def test_margin_progress_reaches_every_limit():
     margin = dlo.Case.load(CASES / "grasp_a_080.json").margin(progress=lambda e, info: seen.append((e, info)))
     assert seen and all(e == "margin" for e, _ in seen)
     assert seen[-1][1]["done"] == seen[-1][1]["total"] == len(margin.table)
+
+
+def test_chord_contacts_keep_a_strip_on_a_corner_out_of_the_block():
+    # The paper's planar strip clamped along +z under the block z >= 0.8, |x| <= 0.2
+    # (planning_cases/plan_paper_planar.json's static problem): at its sample points it keeps
+    # the radius while its polyline cuts the corner; on chords the polyline keeps it.
+    rod = dlo.Rod(length=1.0, flexural_rigidity=1.0, radius=0.005)
+    block = dlo.Obstacle.cuboid("block", [0.2, 0.5, 0.5], position=[0.0, 0.0, 1.3])
+
+    def polyline_gap(contact):
+        problem = dlo.StaticProblem(rod, contact=contact).orientation(0.0, theta=0.0)
+        shape = problem.obstacle(block).solve()
+        assert shape.converged
+        x = np.asarray(shape.positions)
+        pts = [a + t * (b - a) for a, b in zip(x[:-1], x[1:]) for t in np.linspace(0.0, 1.0, 21)]
+        return min(block.signed_distance(list(p))[1] for p in pts) - rod.radius, shape
+
+    points_gap, points = polyline_gap("points")
+    chords_gap, chords = polyline_gap("chords")
+    assert points_gap < -4e-3
+    assert -1e-9 <= chords_gap <= 1e-4
+    assert chords.energy.total > points.energy.total
+    with pytest.raises(dlo.InputError) as e:
+        dlo.StaticProblem(rod, contact="edges")
+    assert e.value.field == "contact"

@@ -281,7 +281,7 @@ impl PlanSettings {
     /// rod and 0 (no tracking) on a 3D one. On the generated suite (seed 1), where the
     /// replayed equilibria of a plan that departs can be the plan, tracking makes 49 of 60
     /// planar plans executable against 39 without, and 3D plans without it are executable as
-    /// often or more (21 of 30 against 20) at a third of the median time (0.85 s against 2.3 s).
+    /// often or more (21 of 30 against 20) at a third of the median time (0.79 s against 2.3 s).
     pub fn tracking_weight(&self, spatial: bool) -> f64 {
         match self.equilibrium_weight {
             Some(w) => w,
