@@ -217,7 +217,6 @@ pub struct Outcome {
 /// model's boundary points (units of L), and where in k.
 fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = &p.base.model;
-    let l = model.rod.length;
     let path = p.with_terms(r.path_terms).path();
     let n = 2 * (p.settings.verify_k_samples - 1);
     let mut a = vec![0.0; path.n()];
@@ -227,13 +226,23 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
         let k = i as f64 / n as f64;
         path.shape_at(&r.z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
-        for x in &shape.positions {
-            for o in &p.obstacles {
-                let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
-                if d / l < worst.0 {
-                    worst = (d / l, k);
-                }
-            }
+        let g = gap(p, &shape.positions);
+        if g < worst.0 {
+            worst = (g, k);
+        }
+    }
+    worst
+}
+
+/// The smallest surface gap `d − r` (units of L) of the dimensionless `positions` to any
+/// obstacle.
+fn gap(p: &Planner, positions: &[[f64; 3]]) -> f64 {
+    let model = &p.base.model;
+    let l = model.rod.length;
+    let mut worst = f64::INFINITY;
+    for x in positions {
+        for o in &p.obstacles {
+            worst = worst.min((o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius) / l);
         }
     }
     worst
@@ -243,20 +252,15 @@ fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
 /// times finer in s than the model's boundary points, and where in k.
 fn replay_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = &p.base.model;
-    let l = model.rod.length;
     let mut worst = (f64::INFINITY, 0.0);
     let Some(first) = r.replay.steps.first() else {
         return worst;
     };
     let fine = fine_model(model, 4 * (first.positions.len() - 1), 2);
     for step in &r.replay.steps {
-        for x in &fine.evaluate(&step.a).positions {
-            for o in &p.obstacles {
-                let d = o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius;
-                if d / l < worst.0 {
-                    worst = (d / l, step.k);
-                }
-            }
+        let g = gap(p, &fine.evaluate(&step.a).positions);
+        if g < worst.0 {
+            worst = (g, step.k);
         }
     }
     worst

@@ -3,10 +3,11 @@
 //! (negative inside). Its gradient is `−n · ∂x/∂a` with `n` the outward normal. The multiplier
 //! `λ ≥ 0` of a row is the contact force magnitude at that sample, pushing along `n`.
 //!
-//! With `chords` (`discretisation.contact: "chords"`; the path optimiser's rows never), `d` is the smallest signed distance over the point and the
-//! half-chords from it towards its neighbouring sample points, so that the rows together keep
-//! the whole polyline through the sample points clear: a rod pressed on an obstacle's corner,
-//! or wrapped round it, no longer dips between its sample points. The row's witness is the
+//! With `chords` (`discretisation.contact: "chords"`; never the path optimiser's rows), `d` is
+//! the smallest signed distance over the point and the half-chords from it towards its
+//! neighbouring sample points, so that the rows together keep the whole polyline through the
+//! sample points clear: a rod pressed on an obstacle's corner, or wrapped round it, no longer
+//! dips between its sample points. The row's witness is the
 //! point of the half-chord `x_b + t (x_n − x_b)`, `t ∈ [0, ½]`, nearest the obstacle; its
 //! gradient is `−n ((1 − t) ∂x_b/∂a + t ∂x_n/∂a)` (the distance's derivative along the chord
 //! vanishes at an interior minimum), and its contact force acts there, split between the two

@@ -16,6 +16,7 @@ use super::Planner;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
 use super::replay::{Replay, ReplayOptions, max_distance, replay};
+use crate::rod::model::Model;
 use serde::Serialize;
 
 /// The replayed equilibria along the optimal path's trajectory, as a plan.
@@ -94,11 +95,7 @@ fn failure(first: &Replay) -> Option<String> {
 /// verification grid in s (the static solves hold their contacts at their own sample points
 /// only, and a shape leaning on a corner can dip between them): the first failure, if any,
 /// and the smallest obstacle clearance (case units).
-fn penetration(
-    planner: &Planner,
-    fine: &crate::rod::model::Model,
-    replay: &Replay,
-) -> (Option<String>, Option<f64>) {
+fn penetration(planner: &Planner, fine: &Model, replay: &Replay) -> (Option<String>, Option<f64>) {
     let (worst, self_gap) = super::verify::shapes_clearance(
         fine,
         &planner.obstacles,
@@ -131,13 +128,15 @@ fn penetration(
 }
 
 impl Planner {
-    /// The equilibrium plan of `first`, the replay of `path(z)`: checked, and confirmed by a
-    /// replay on twice as many steps (run only when every other check passes).
+    /// The equilibrium plan of `first`, the replay of `path(z)`: checked (clearances on the
+    /// verification model `fine`), and confirmed by a replay on twice as many steps (run only
+    /// when every other check passes).
     pub(super) fn equilibrium_plan(
         &self,
         path: &DeformationPath,
         z: &[f64],
         first: &Replay,
+        fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> EquilibriumPlan {
         let (iu, u_max) = first
@@ -157,9 +156,8 @@ impl Planner {
             confirmation_steps: None,
             confirmation_deviation_over_l: None,
         };
-        let fine = super::verify::fine_model(&self.base.model, self.settings.verify_s_samples, 2);
         if plan.reason.is_none() {
-            let (why, clearance) = penetration(self, &fine, first);
+            let (why, clearance) = penetration(self, fine, first);
             plan.reason = why;
             plan.min_clearance = clearance;
         }
@@ -198,7 +196,7 @@ impl Planner {
         }
         plan.confirmation_steps = Some(opts.steps);
         plan.confirmation_deviation_over_l = Some(worst);
-        let (why, clearance) = penetration(self, &fine, &second);
+        let (why, clearance) = penetration(self, fine, &second);
         plan.min_clearance = match (plan.min_clearance, clearance) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),

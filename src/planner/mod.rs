@@ -409,6 +409,8 @@ fn held_frame(base: &StaticProblem) -> ([f64; 3], bool) {
 struct Judged {
     replay: Replay,
     equilibrium_plan: Option<equilibrium_plan::EquilibriumPlan>,
+    /// The controlled end against the workspace (`None` without one).
+    workspace: Option<result::WorkspaceCheck>,
     shapes: RecordedShapes,
     seconds: f64,
     /// The optimal path coincides with its replay (collision-free and converged), or the
@@ -422,6 +424,7 @@ impl Judged {
         Judged {
             replay: Replay::not_run(tolerance),
             equilibrium_plan: None,
+            workspace: None,
             shapes: RecordedShapes::default(),
             seconds: 0.0,
             executable: false,
@@ -447,8 +450,14 @@ impl Planner {
     }
 
     /// Replays `run`'s plan and, where the plan is not executable as it stands, checks its
-    /// replayed equilibria as a plan; the shapes are kept, not logged.
-    fn judge(&self, run: &StartPlan, observer: &mut dyn PlanObserver) -> Judged {
+    /// replayed equilibria as a plan on the verification model `fine`; the shapes are kept,
+    /// not logged.
+    fn judge(
+        &self,
+        run: &StartPlan,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
         let t = std::time::Instant::now();
         let path = self.with_terms(run.terms).path();
         let z = &run.plan.run.z;
@@ -463,9 +472,8 @@ impl Planner {
             &mut rec,
             &self.stop,
         );
-        let within = self
-            .workspace_excess(&path, z)
-            .is_none_or(|(e, _)| e <= self.collision_tolerance());
+        let workspace = self.workspace_check(&path, z);
+        let within = workspace.is_none_or(|w| w.within);
         let as_planned = run
             .plan
             .verification
@@ -473,13 +481,14 @@ impl Planner {
             && run.plan.run.status == AlStatus::Converged
             && rep.coincide;
         let equilibrium_plan = (!as_planned && self.settings.equilibrium_plans && !self.stopped())
-            .then(|| self.equilibrium_plan(&path, z, &rep, &mut rec));
+            .then(|| self.equilibrium_plan(&path, z, &rep, fine, &mut rec));
         let executable = !self.stopped()
             && within
             && (as_planned || equilibrium_plan.as_ref().is_some_and(|e| e.executable));
         Judged {
             replay: rep,
             equilibrium_plan,
+            workspace,
             shapes: rec.into_shapes(),
             seconds: t.elapsed().as_secs_f64(),
             executable,
@@ -671,8 +680,13 @@ impl Planner {
     }
 
     /// How far the controlled end of `path(z)` leaves the workspace on the verification grid
-    /// in k (case units), and where: `None` without a workspace.
-    pub fn workspace_excess(&self, path: &DeformationPath, z: &[f64]) -> Option<(f64, f64)> {
+    /// in k (case units), where, and whether within the collision tolerance: `None` without a
+    /// workspace.
+    pub fn workspace_check(
+        &self,
+        path: &DeformationPath,
+        z: &[f64],
+    ) -> Option<result::WorkspaceCheck> {
         let w = self.settings.workspace.as_ref()?;
         let model = &self.base.model;
         let (l, b) = (model.rod.length, model.boundary(1.0));
@@ -689,7 +703,11 @@ impl Planner {
                 worst = (e, k);
             }
         }
-        Some(worst)
+        Some(result::WorkspaceCheck {
+            largest_excess: worst.0,
+            k: worst.1,
+            within: worst.0 <= self.collision_tolerance(),
+        })
     }
 
     /// Optimises, verifies and replays the plan.
@@ -759,7 +777,7 @@ impl Planner {
             if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
                 return j.executable;
             }
-            let j = self.judge(&runs[best], observer);
+            let j = self.judge(&runs[best], &fine, observer);
             let executable = j.executable;
             judged.push((best, j));
             executable
@@ -782,7 +800,7 @@ impl Planner {
         let judged = match judged.into_iter().find(|(i, _)| *i == best) {
             Some((_, j)) => j,
             None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
-            None => self.judge(&runs[best], observer),
+            None => self.judge(&runs[best], &fine, observer),
         };
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
 
@@ -790,16 +808,12 @@ impl Planner {
         flush(&judged.shapes, model, observer);
         let interrupted = self.poll(observer) || self.stopped();
         let t_replay = judged.seconds;
-        let (rep, equilibrium_plan) = (judged.replay, judged.equilibrium_plan);
+        let (rep, equilibrium_plan, judged_workspace) =
+            (judged.replay, judged.equilibrium_plan, judged.workspace);
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
         let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
-        let workspace =
-            self.workspace_excess(&path, &chosen.z)
-                .map(|(excess, k)| result::WorkspaceCheck {
-                    largest_excess: excess,
-                    k,
-                    within: excess <= tol,
-                });
+        // Judged with the replay; a run stopped before it is checked here.
+        let workspace = judged_workspace.or_else(|| self.workspace_check(&path, &chosen.z));
         let status = if interrupted {
             PlanStatus::Interrupted
         } else if !ver.collision_free(tol) {
