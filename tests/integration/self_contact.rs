@@ -7,23 +7,36 @@ use dlo_planner::planner::verify::{fine_model, verify_with};
 use dlo_planner::planner::{PlanStatus, Planner};
 use dlo_planner::rod::layout::Field;
 use dlo_planner::statics::{SolveStatus, StaticSolution, solve_static};
+use serde_json::{Value, json};
 use std::path::Path;
 
 /// `planning_cases/self_contact_crossed_loop.json` (a 3D rod, L = 100, r = 0.5, clamped at the
 /// origin along +x and at (0, 0, 10) along −x, turned by +π in between: in the x–z plane the
 /// loop can only reach its second clamp by crossing its first leg), with or without
-/// self-contact.
+/// self-contact, in the paper's basis of 4 pairs (the discretisation `plan_loop_flip` writes its
+/// shapes in).
 fn crossed_loop(self_contact: bool) -> (case::Case, StaticSolution) {
-    crossed_loop_in(self_contact, "auto")
+    crossed_loop_in(
+        self_contact,
+        "auto",
+        Some(json!({ "basis": "paper", "basis_pairs": 4 })),
+    )
 }
 
-/// [`crossed_loop`] with its angles measured as `angle_frame` says.
-fn crossed_loop_in(self_contact: bool, angle_frame: &str) -> (case::Case, StaticSolution) {
-    let text = shipped("self_contact_crossed_loop").replace(
-        r#""self_contact": true"#,
-        &format!(r#""self_contact": {self_contact}, "angle_frame": "{angle_frame}""#),
-    );
-    let mut c = case::parse(&text, Path::new("crossed_loop.json")).unwrap();
+/// The crossed loop with its angles measured as `angle_frame` says, discretised as given
+/// (`None`: as shipped).
+fn crossed_loop_in(
+    self_contact: bool,
+    angle_frame: &str,
+    discretisation: Option<Value>,
+) -> (case::Case, StaticSolution) {
+    let mut v: Value = serde_json::from_str(&shipped("self_contact_crossed_loop")).unwrap();
+    v["self_contact"] = json!(self_contact);
+    v["angle_frame"] = json!(angle_frame);
+    if let Some(d) = discretisation {
+        v["discretisation"] = d;
+    }
+    let mut c = case::parse(&v.to_string(), Path::new("crossed_loop.json")).unwrap();
     let a0 = c.initial.clone();
     let sol = solve_static(&mut c.problem, &a0, &c.options);
     assert_eq!(
@@ -103,6 +116,37 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
     );
 }
 
+/// The loop as shipped, in Legendre polynomials of degree 33 per angle from the frame away from
+/// the pole: resolved, its moments balance (reactions and the contact pair) to 1e-6 of the
+/// largest, and it still touches itself at one pair s, L − s, pressed across the plane; its
+/// energy and contact force hold when the contact samples double (1e-6 and 1e-2 relative). The
+/// paper's basis of 4 pairs overstates the force about twelvefold (1.6e-3 against 1.3e-4).
+#[test]
+fn the_resolved_loop_touches_itself_and_balances() {
+    let (_, held) = crossed_loop_in(true, "auto", None);
+    assert!(held.balance.relative <= 1e-6, "{:?}", held.balance);
+    assert_eq!(held.stable, Some(true));
+    let (_, free) = crossed_loop_in(false, "auto", None);
+    assert!(held.energy.potential() > free.energy.potential());
+    let force = |sol: &StaticSolution| {
+        assert_eq!(sol.self_contacts.len(), 1, "{:?}", sol.self_contacts);
+        let contact = &sol.self_contacts[0];
+        let [sa, sb] = contact.s;
+        assert!((sa + sb - 100.0).abs() < 1e-5, "contact at s = {sa}, {sb}");
+        let f = contact.force;
+        let size = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        assert!(f[1].abs() > 0.99 * size, "not across the plane: {f:?}");
+        size
+    };
+    let f32 = force(&held);
+    let disc = json!({ "basis": "legendre", "basis_pairs": 16, "panels": 64, "samples": 64 });
+    let (_, fine) = crossed_loop_in(true, "auto", Some(disc));
+    let f64_ = force(&fine);
+    assert!((f32 - f64_).abs() <= 1e-2 * f64_, "{f32} vs {f64_}");
+    let (e32, e64) = (held.energy.potential(), fine.energy.potential());
+    assert!((e32 - e64).abs() <= 1e-6 * e64, "{e32} vs {e64}");
+}
+
 /// Self-contact rows that decide a plan (`planning_cases/plan_loop_flip.json`). Start: the
 /// crossed loop of [`a_loop_that_would_cross_itself_touches_itself_instead`] (held at s = L by
 /// the controlled end), its first leg passing over the second; goal: its mirror image in the
@@ -118,7 +162,8 @@ fn a_loop_that_would_cross_itself_touches_itself_instead() {
 #[test]
 fn a_plan_flips_a_crossing_without_passing_the_rod_through_itself() {
     // The flip case writes its end shapes as coefficients of the case's own angles.
-    let (c, held) = crossed_loop_in(true, "case");
+    let paper = json!({ "basis": "paper", "basis_pairs": 4 });
+    let (c, held) = crossed_loop_in(true, "case", Some(paper));
     // The shipped start is this solve's shape.
     let lay = &c.problem.model.layout;
     let flip = case::parse(&shipped("plan_loop_flip"), Path::new("flip.json")).unwrap();
