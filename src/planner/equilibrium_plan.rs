@@ -11,12 +11,18 @@
 //! points, and a shape leaning on an obstacle's corner can dip between them. A second replay on
 //! twice as many steps confirms that they do not depend on the step: it must reach the same
 //! shapes, within the coincidence tolerance, at every `k` both replays share.
+//!
+//! Where the shapes dip between contact points, the replay is run again with the contacts held
+//! on the chords between them (`discretisation.contact: "chords"`, whatever the case says), and
+//! its equilibria, checked and confirmed the same way, are the plan if they pass.
 
 use super::Planner;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
 use super::replay::{Replay, ReplayOptions, max_distance, replay};
+use crate::constraints::Constraint;
 use crate::rod::model::Model;
+use crate::statics::StaticProblem;
 use serde::Serialize;
 
 /// The replayed equilibria along the optimal path's trajectory, as a plan.
@@ -46,6 +52,29 @@ pub struct EquilibriumPlan {
     /// Largest distance between the two replays' shapes at the `k` they share (fraction of
     /// `L`; `null` when the confirmation did not run).
     pub confirmation_deviation_over_l: Option<f64>,
+    /// Where the replay's solves held the obstacle contacts: `"points"` (at the sample points)
+    /// or `"chords"` (on the chords between them: as the case says, or the replay run again so
+    /// after shapes held at the points dipped between them).
+    pub contact: &'static str,
+    /// The shapes dip into an obstacle between the solves' contact points.
+    #[serde(skip)]
+    pub(crate) dips: bool,
+}
+
+/// `base` with every obstacle contact held on the chords between sample points, or `None` when
+/// it has no obstacle held at its points alone.
+pub(super) fn on_chords(base: &StaticProblem) -> Option<StaticProblem> {
+    let mut out = base.clone();
+    let mut changed = false;
+    for con in out.constraints.iter_mut() {
+        if let Constraint::Obstacle(ob) = con
+            && !ob.chords
+        {
+            ob.chords = true;
+            changed = true;
+        }
+    }
+    changed.then_some(out)
 }
 
 /// An observer that passes on only the question whether to stop: the confirmation replay's
@@ -95,7 +124,11 @@ fn failure(first: &Replay) -> Option<String> {
 /// verification grid in s (the static solves hold their contacts at their own sample points
 /// only, and a shape leaning on a corner can dip between them): the first failure, if any,
 /// and the smallest obstacle clearance (case units).
-fn penetration(planner: &Planner, fine: &Model, replay: &Replay) -> (Option<String>, Option<f64>) {
+fn penetration(
+    planner: &Planner,
+    fine: &Model,
+    replay: &Replay,
+) -> (Option<String>, Option<f64>, bool) {
     let (worst, self_gap) = super::verify::shapes_clearance(
         fine,
         &planner.obstacles,
@@ -114,6 +147,7 @@ fn penetration(planner: &Planner, fine: &Model, replay: &Replay) -> (Option<Stri
                 -w.clearance, w.obstacle, w.k, w.s
             )),
             min_clearance,
+            true,
         );
     }
     if let Some((g, k)) = self_gap.filter(|(g, _)| *g < -tol) {
@@ -122,17 +156,20 @@ fn penetration(planner: &Planner, fine: &Model, replay: &Replay) -> (Option<Stri
                 "a replayed shape crosses itself (gap {g:.3e}) at k = {k:.4}"
             )),
             min_clearance,
+            false,
         );
     }
-    (None, min_clearance)
+    (None, min_clearance, false)
 }
 
 impl Planner {
-    /// The equilibrium plan of `first`, the replay of `path(z)`: checked (clearances on the
-    /// verification model `fine`), and confirmed by a replay on twice as many steps (run only
-    /// when every other check passes).
+    /// The equilibrium plan of `first`, the replay of `path(z)` under `base` (the planner's
+    /// held problem, or its copy [`on_chords`]): checked (clearances on the verification model
+    /// `fine`), and confirmed by a replay on twice as many steps (run only when every other
+    /// check passes).
     pub(super) fn equilibrium_plan(
         &self,
+        base: &StaticProblem,
         path: &DeformationPath,
         z: &[f64],
         first: &Replay,
@@ -155,11 +192,22 @@ impl Planner {
             k_at_max_contact_force: first.k_at_max_contact_force,
             confirmation_steps: None,
             confirmation_deviation_over_l: None,
+            contact: if base
+                .constraints
+                .iter()
+                .any(|c| matches!(c, Constraint::Obstacle(ob) if ob.chords))
+            {
+                "chords"
+            } else {
+                "points"
+            },
+            dips: false,
         };
         if plan.reason.is_none() {
-            let (why, clearance) = penetration(self, fine, first);
+            let (why, clearance, dips) = penetration(self, fine, first);
             plan.reason = why;
             plan.min_clearance = clearance;
+            plan.dips = dips;
         }
         if plan.reason.is_some() || self.stopped() {
             plan.reason.get_or_insert_with(|| "interrupted".into());
@@ -170,7 +218,7 @@ impl Planner {
             ..self.settings.replay()
         };
         let second = replay(
-            &self.base,
+            base,
             &self.start,
             path,
             z,
@@ -196,7 +244,8 @@ impl Planner {
         }
         plan.confirmation_steps = Some(opts.steps);
         plan.confirmation_deviation_over_l = Some(worst);
-        let (why, clearance) = penetration(self, fine, &second);
+        let (why, clearance, dips) = penetration(self, fine, &second);
+        plan.dips = dips;
         plan.min_clearance = match (plan.min_clearance, clearance) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),

@@ -480,8 +480,39 @@ impl Planner {
             .collision_free(self.collision_tolerance())
             && run.plan.run.status == AlStatus::Converged
             && rep.coincide;
-        let equilibrium_plan = (!as_planned && self.settings.equilibrium_plans && !self.stopped())
-            .then(|| self.equilibrium_plan(&path, z, &rep, fine, &mut rec));
+        let mut equilibrium_plan =
+            (!as_planned && self.settings.equilibrium_plans && !self.stopped())
+                .then(|| self.equilibrium_plan(&self.base, &path, z, &rep, fine, &mut rec));
+        let mut rep = rep;
+        let mut shapes = rec.into_shapes();
+        // Equilibria that dip between the solves' contact points: replayed again with the
+        // contacts on the chords between them.
+        if let Some(ep) = equilibrium_plan
+            .as_mut()
+            .filter(|e| e.dips && !self.stopped())
+            && let Some(chords) = equilibrium_plan::on_chords(&self.base)
+        {
+            let mut rec = Recorder::new(observer);
+            let again = replay(
+                &chords,
+                &self.start,
+                &path,
+                z,
+                self.settings.replay(),
+                &self.static_options,
+                &mut rec,
+                &self.stop,
+            );
+            let on_chords = self.equilibrium_plan(&chords, &path, z, &again, fine, &mut rec);
+            if on_chords.executable {
+                *ep = on_chords;
+                rep = again;
+                shapes = rec.into_shapes();
+            } else if let Some(why) = on_chords.reason {
+                let first = ep.reason.take().unwrap_or_default();
+                ep.reason = Some(format!("{first}; replayed with contacts on chords: {why}"));
+            }
+        }
         let executable = !self.stopped()
             && within
             && (as_planned || equilibrium_plan.as_ref().is_some_and(|e| e.executable));
@@ -489,7 +520,7 @@ impl Planner {
             replay: rep,
             equilibrium_plan,
             workspace,
-            shapes: rec.into_shapes(),
+            shapes,
             seconds: t.elapsed().as_secs_f64(),
             executable,
         }

@@ -73,7 +73,6 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
-    use dlo_planner::planner::verify::fine_model;
     let mut rng = Rng(1);
     let text = (0..=7)
         .map(|i| planar_problem(&mut rng, i))
@@ -91,6 +90,56 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     assert!(e.executable && e.reason.is_none());
     assert!(e.confirmation_deviation_over_l.expect("confirmed") <= r.replay.tolerance);
     assert_eq!(e.confirmation_steps, Some(2 * p.settings.replay_steps));
+    assert_eq!(e.contact, "points");
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
+/// The suite's 3D problem `spatial_1_27` (seed 1), planned with the defaults: its optimal path's replay
+/// departs, and the replayed equilibria, their contacts held at the static solves' sample
+/// points, lean on an obstacle and dip 6.9e-4 L into it between those points. Replayed again
+/// with the contacts on the chords between them, the equilibria are the executable plan, checked
+/// as above: held at the trajectory's poses, ending on the goal shape, no shape inside an
+/// obstacle on a grid four times finer in s.
+#[test]
+fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
+    use dlo_planner::case;
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::observer::Silent;
+    // The suite draws its 3D problems after its planar ones: 68 of them for seed 1 (60 with
+    // static start and goal shapes).
+    let mut rng = Rng(1);
+    for i in 0..68 {
+        planar_problem(&mut rng, i);
+    }
+    let text = (0..=27)
+        .map(|i| spatial_problem(&mut rng, i))
+        .last()
+        .expect("28 problems");
+    let c = case::parse(
+        &text,
+        std::path::Path::new("planning_cases/spatial_27.json"),
+    )
+    .expect("a generated case");
+    let p = Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(&mut Silent);
+    assert!(!r.replay.coincide, "the optimal path's replay coincides");
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    assert!(r.verdict().is_executable());
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none(), "{e:?}");
+    assert_eq!(e.contact, "chords");
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
+/// The independent checks of a plan executed by its replayed equilibria: every replayed shape is
+/// held at the trajectory's pose (its end's position to 1e-9 L and its frame to 1e-9), converged
+/// and not unstable; the last one is the goal shape (within the coincidence tolerance); no shape
+/// comes closer to an obstacle than the rod's radius on a grid four times finer in s (−1e-6 L).
+fn held_on_the_trajectory_clear_of_obstacles(
+    p: &dlo_planner::planner::Planner,
+    r: &dlo_planner::planner::PlanResult,
+) {
+    use dlo_planner::planner::verify::fine_model;
     let model = &p.base.model;
     let l = model.rod.length;
     assert_eq!(r.replay.steps.len(), r.trajectory.poses.len());
