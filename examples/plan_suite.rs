@@ -198,6 +198,8 @@ pub struct Outcome {
     pub executable: bool,
     /// Executable by the replayed equilibria (not the optimal path itself).
     pub by_equilibria: bool,
+    /// Of those, along the straight-line path's trajectory (no optimised path executable).
+    pub by_straight: bool,
     /// Why not executable: the verdict, and why the replayed equilibria are not a plan.
     pub why_not: Option<String>,
     pub snaps: bool,
@@ -303,13 +305,19 @@ pub fn run(
     let seconds = t0.elapsed().as_secs_f64();
     let planned = r.status == PlanStatus::Planned;
     let executed = r.executed_path();
+    // The report's replay is the straight-line path's where the plan follows its trajectory.
+    let along_straight = r
+        .equilibrium_plan
+        .as_ref()
+        .is_some_and(|e| e.trajectory == "straight_path");
     let t = &r.trajectory;
     Some(Outcome {
         name: name.to_string(),
         planned,
-        coincide: planned && r.replay.coincide,
+        coincide: planned && r.replay.coincide && !along_straight,
         executable: executed.is_some(),
         by_equilibria: executed == Some("equilibria"),
+        by_straight: executed.is_some() && along_straight,
         why_not: executed.is_none().then(|| {
             format!(
                 "{}{}",
@@ -354,6 +362,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let coincide = out.iter().filter(|o| o.coincide).count();
     let executable = out.iter().filter(|o| o.executable).count();
     let by_equilibria = out.iter().filter(|o| o.by_equilibria).count();
+    let by_straight = out.iter().filter(|o| o.by_straight).count();
     let snaps = out.iter().filter(|o| o.snaps).count();
     let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
     let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
@@ -363,7 +372,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
-        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
         pct(planned),
         pct(coincide),
         pct(executable),

@@ -56,6 +56,14 @@ pub struct EquilibriumPlan {
     /// or `"chords"` (on the chords between them: as the case says, or the replay run again so
     /// after shapes held at the points dipped between them).
     pub contact: &'static str,
+    /// Whose end poses the gripper follows: `"optimal_path"` (the optimal path's, as the
+    /// replay) or `"straight_path"` (the straight-line path's, tried when no optimised path is
+    /// executable, neither as it stands nor by its equilibria).
+    pub trajectory: &'static str,
+    /// Along the straight-line path's trajectory: why the optimal path was not executable, as
+    /// it stands or by its equilibria (`None` otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optimal_path_not_executable: Option<String>,
     /// The shapes dip into an obstacle between the solves' contact points.
     #[serde(skip)]
     pub(crate) dips: bool,
@@ -201,6 +209,8 @@ impl Planner {
             } else {
                 "points"
             },
+            trajectory: "optimal_path",
+            optimal_path_not_executable: None,
             dips: false,
         };
         if plan.reason.is_none() {

@@ -458,31 +458,43 @@ impl Planner {
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> Judged {
-        let t = std::time::Instant::now();
         let path = self.with_terms(run.terms).path();
-        let z = &run.plan.run.z;
+        let planned = run
+            .plan
+            .verification
+            .collision_free(self.collision_tolerance())
+            && run.plan.run.status == AlStatus::Converged;
+        self.judge_path(&path, &run.plan.run.z, planned, fine, observer)
+    }
+
+    /// [`Self::judge`] of `path(z)`, executable as it stands when it coincides with its replay
+    /// and `planned` (collision-free and converged).
+    fn judge_path(
+        &self,
+        path: &DeformationPath,
+        z: &[f64],
+        planned: bool,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let t = std::time::Instant::now();
         let mut rec = Recorder::new(observer);
         let rep = replay(
             &self.base,
             &self.start,
-            &path,
+            path,
             z,
             self.settings.replay(),
             &self.static_options,
             &mut rec,
             &self.stop,
         );
-        let workspace = self.workspace_check(&path, z);
+        let workspace = self.workspace_check(path, z);
         let within = workspace.is_none_or(|w| w.within);
-        let as_planned = run
-            .plan
-            .verification
-            .collision_free(self.collision_tolerance())
-            && run.plan.run.status == AlStatus::Converged
-            && rep.coincide;
+        let as_planned = planned && rep.coincide;
         let mut equilibrium_plan =
             (!as_planned && self.settings.equilibrium_plans && !self.stopped())
-                .then(|| self.equilibrium_plan(&self.base, &path, z, &rep, fine, &mut rec));
+                .then(|| self.equilibrium_plan(&self.base, path, z, &rep, fine, &mut rec));
         let mut rep = rep;
         let mut shapes = rec.into_shapes();
         // Equilibria that dip between the solves' contact points: replayed again with the
@@ -496,14 +508,14 @@ impl Planner {
             let again = replay(
                 &chords,
                 &self.start,
-                &path,
+                path,
                 z,
                 self.settings.replay(),
                 &self.static_options,
                 &mut rec,
                 &self.stop,
             );
-            let on_chords = self.equilibrium_plan(&chords, &path, z, &again, fine, &mut rec);
+            let on_chords = self.equilibrium_plan(&chords, path, z, &again, fine, &mut rec);
             if on_chords.executable {
                 *ep = on_chords;
                 rep = again;
@@ -833,6 +845,45 @@ impl Planner {
             None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
             None => self.judge(&runs[best], &fine, observer),
         };
+        // Nothing executable: the trajectory of the straight-line path's end, with the
+        // equilibria the end poses produce (touching obstacles where the straight shapes cross
+        // them), as the plan if they pass.
+        let straight_path = self.path();
+        let straight_z = vec![0.0; straight_path.n_vars()];
+        let mut judged = judged;
+        let mut along_straight = false;
+        if !judged.executable && self.settings.equilibrium_plans && !self.stopped() {
+            let mut s = self.judge_path(&straight_path, &straight_z, false, &fine, observer);
+            if let Some(e) = s.equilibrium_plan.as_mut() {
+                e.trajectory = "straight_path";
+            }
+            if s.executable {
+                let why = judged
+                    .equilibrium_plan
+                    .as_ref()
+                    .and_then(|e| e.reason.clone())
+                    .unwrap_or_else(|| {
+                        if judged.workspace.as_ref().is_some_and(|w| !w.within) {
+                            "its end leaves the workspace".into()
+                        } else {
+                            "not executable".into()
+                        }
+                    });
+                if let Some(e) = s.equilibrium_plan.as_mut() {
+                    e.optimal_path_not_executable = Some(why);
+                }
+                judged = s;
+                along_straight = true;
+            } else if let (Some(e), Some(why)) = (
+                judged.equilibrium_plan.as_mut(),
+                s.equilibrium_plan.and_then(|e| e.reason),
+            ) {
+                let first = e.reason.take().unwrap_or_default();
+                e.reason = Some(format!(
+                    "{first}; along the straight path's trajectory: {why}"
+                ));
+            }
+        }
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
 
         observer.phase("replay");
@@ -842,9 +893,14 @@ impl Planner {
         let (rep, equilibrium_plan, judged_workspace) =
             (judged.replay, judged.equilibrium_plan, judged.workspace);
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
-        let trajectory = trajectory::Trajectory::along(model, &path, &chosen.z, &ks);
+        let (traj_path, traj_z) = if along_straight {
+            (&straight_path, &straight_z)
+        } else {
+            (&path, &chosen.z)
+        };
+        let trajectory = trajectory::Trajectory::along(model, traj_path, traj_z, &ks);
         // Judged with the replay; a run stopped before it is checked here.
-        let workspace = judged_workspace.or_else(|| self.workspace_check(&path, &chosen.z));
+        let workspace = judged_workspace.or_else(|| self.workspace_check(traj_path, traj_z));
         let status = if interrupted {
             PlanStatus::Interrupted
         } else if !ver.collision_free(tol) {

@@ -179,12 +179,18 @@ pub struct PlanResult {
 impl PlanResult {
     /// What the gripper trajectory executes: `"optimal"`, the optimal path itself (collision-free,
     /// converged, and its replay coincides), else `"equilibria"`, the replayed equilibria along
-    /// its trajectory (see [`super::equilibrium_plan`]), else nothing.
+    /// its trajectory, or along the straight-line path's when no optimised path executes
+    /// (`equilibrium_plan.trajectory`; see [`super::equilibrium_plan`]), else nothing.
     pub fn executed_path(&self) -> Option<&'static str> {
         if self.workspace.as_ref().is_some_and(|w| !w.within) {
             return None;
         }
-        if self.status == PlanStatus::Planned && self.replay.coincide {
+        // Along the straight-line path's trajectory, the replay is that path's.
+        let straight = self
+            .equilibrium_plan
+            .as_ref()
+            .is_some_and(|e| e.trajectory == "straight_path");
+        if self.status == PlanStatus::Planned && self.replay.coincide && !straight {
             Some("optimal")
         } else if self.equilibrium_plan.as_ref().is_some_and(|e| e.executable) {
             Some("equilibria")

@@ -131,6 +131,51 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's 3D problem `spatial_1_17` (seed 1), planned with the defaults: no optimised path
+/// is executable (the replay of the best snaps through), but the equilibria along the
+/// straight-line path's end poses are: the plan follows that trajectory, says why the optimal
+/// path does not execute, and passes the same independent checks.
+#[test]
+fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
+    use dlo_planner::case;
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::observer::Silent;
+    let mut rng = Rng(1);
+    for i in 0..68 {
+        planar_problem(&mut rng, i);
+    }
+    let text = (0..=17)
+        .map(|i| spatial_problem(&mut rng, i))
+        .last()
+        .expect("18 problems");
+    let c = case::parse(
+        &text,
+        std::path::Path::new("planning_cases/spatial_17.json"),
+    )
+    .expect("a generated case");
+    let p = Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(&mut Silent);
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none(), "{e:?}");
+    assert_eq!(e.trajectory, "straight_path");
+    let why = e.optimal_path_not_executable.as_deref().expect("a reason");
+    assert!(why.contains("snaps through"), "{why}");
+    // The trajectory is the straight-line path's: its end poses at the replay's k.
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let model = &p.base.model;
+    let mut a = vec![0.0; path.n()];
+    for pose in &r.trajectory.poses {
+        path.shape_at(&z, pose.k, &mut a);
+        let x = model.position_at(&a, 1.0);
+        for (xi, pi) in x.iter().zip(&pose.position) {
+            assert!((xi * model.rod.length - pi).abs() <= 1e-9);
+        }
+    }
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
 /// The independent checks of a plan executed by its replayed equilibria: every replayed shape is
 /// held at the trajectory's pose (its end's position to 1e-9 L and its frame to 1e-9), converged
 /// and not unstable; the last one is the goal shape (within the coincidence tolerance); no shape

@@ -270,6 +270,11 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         r.case,
         r.verdict,
         match r.executed_path {
+            Some("equilibria")
+                if p.equilibrium_plan
+                    .as_ref()
+                    .is_some_and(|e| e.trajectory == "straight_path") =>
+                " by the replayed equilibria along the straight-line path's trajectory",
             Some("equilibria") => " by the replayed equilibria along the optimal path's trajectory",
             Some(_) => " as optimised",
             None => "",
@@ -371,6 +376,12 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         );
     }
     if let Some(e) = &p.equilibrium_plan {
+        if let Some(why) = &e.optimal_path_not_executable {
+            let _ = writeln!(
+                o,
+                "  the optimal path is not executable ({why}); the gripper follows the straight-line path's end poses"
+            );
+        }
         let _ = writeln!(
             o,
             "  replayed equilibria as the plan: {}; U_max {:.6e} at k = {:.3}{}",
