@@ -467,6 +467,27 @@ impl Planner {
         self.judge_path(&path, &run.plan.run.z, planned, fine, observer)
     }
 
+    /// The replay of `path(z)` from the start shape under `base` (the held problem, or a copy
+    /// with other contacts), with the plan's replay settings.
+    fn replay_under(
+        &self,
+        base: &StaticProblem,
+        path: &DeformationPath,
+        z: &[f64],
+        observer: &mut dyn PlanObserver,
+    ) -> Replay {
+        replay(
+            base,
+            &self.start,
+            path,
+            z,
+            self.settings.replay(),
+            &self.static_options,
+            observer,
+            &self.stop,
+        )
+    }
+
     /// [`Self::judge`] of `path(z)`, executable as it stands when it coincides with its replay
     /// and `planned` (collision-free and converged).
     fn judge_path(
@@ -479,16 +500,7 @@ impl Planner {
     ) -> Judged {
         let t = std::time::Instant::now();
         let mut rec = Recorder::new(observer);
-        let rep = replay(
-            &self.base,
-            &self.start,
-            path,
-            z,
-            self.settings.replay(),
-            &self.static_options,
-            &mut rec,
-            &self.stop,
-        );
+        let rep = self.replay_under(&self.base, path, z, &mut rec);
         let workspace = self.workspace_check(path, z);
         let within = workspace.is_none_or(|w| w.within);
         let as_planned = planned && rep.coincide;
@@ -505,16 +517,7 @@ impl Planner {
             && let Some(chords) = equilibrium_plan::on_chords(&self.base)
         {
             let mut rec = Recorder::new(observer);
-            let again = replay(
-                &chords,
-                &self.start,
-                path,
-                z,
-                self.settings.replay(),
-                &self.static_options,
-                &mut rec,
-                &self.stop,
-            );
+            let again = self.replay_under(&chords, path, z, &mut rec);
             let on_chords = self.equilibrium_plan(&chords, path, z, &again, fine, &mut rec);
             if on_chords.executable {
                 *ep = on_chords;

@@ -94,6 +94,33 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's 3D problem `spatial_1_{i}` (seed 1), planned with the defaults. The suite draws
+/// its 3D problems after its planar ones: 68 of them for seed 1 (60 with static start and goal
+/// shapes).
+fn suite_3d_plan(
+    i: usize,
+) -> (
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::PlanResult,
+) {
+    use dlo_planner::case;
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::observer::Silent;
+    let mut rng = Rng(1);
+    for j in 0..68 {
+        planar_problem(&mut rng, j);
+    }
+    let text = (0..=i)
+        .map(|j| spatial_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let path = format!("planning_cases/spatial_{i}.json");
+    let c = case::parse(&text, std::path::Path::new(&path)).expect("a generated case");
+    let p = Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(&mut Silent);
+    (p, r)
+}
+
 /// The suite's 3D problem `spatial_1_27` (seed 1), planned with the defaults: its optimal path's replay
 /// departs, and the replayed equilibria, their contacts held at the static solves' sample
 /// points, lean on an obstacle and dip 6.9e-4 L into it between those points. Replayed again
@@ -102,26 +129,7 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
 /// obstacle on a grid four times finer in s.
 #[test]
 fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
-    use dlo_planner::case;
-    use dlo_planner::planner::Planner;
-    use dlo_planner::planner::observer::Silent;
-    // The suite draws its 3D problems after its planar ones: 68 of them for seed 1 (60 with
-    // static start and goal shapes).
-    let mut rng = Rng(1);
-    for i in 0..68 {
-        planar_problem(&mut rng, i);
-    }
-    let text = (0..=27)
-        .map(|i| spatial_problem(&mut rng, i))
-        .last()
-        .expect("28 problems");
-    let c = case::parse(
-        &text,
-        std::path::Path::new("planning_cases/spatial_27.json"),
-    )
-    .expect("a generated case");
-    let p = Planner::from_case(&c).expect("start and goal solve");
-    let r = p.run(&mut Silent);
+    let (p, r) = suite_3d_plan(27);
     assert!(!r.replay.coincide, "the optimal path's replay coincides");
     assert_eq!(r.executed_path(), Some("equilibria"));
     assert!(r.verdict().is_executable());
@@ -137,24 +145,7 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
 /// path does not execute, and passes the same independent checks.
 #[test]
 fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
-    use dlo_planner::case;
-    use dlo_planner::planner::Planner;
-    use dlo_planner::planner::observer::Silent;
-    let mut rng = Rng(1);
-    for i in 0..68 {
-        planar_problem(&mut rng, i);
-    }
-    let text = (0..=17)
-        .map(|i| spatial_problem(&mut rng, i))
-        .last()
-        .expect("18 problems");
-    let c = case::parse(
-        &text,
-        std::path::Path::new("planning_cases/spatial_17.json"),
-    )
-    .expect("a generated case");
-    let p = Planner::from_case(&c).expect("start and goal solve");
-    let r = p.run(&mut Silent);
+    let (p, r) = suite_3d_plan(17);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");
