@@ -14,7 +14,9 @@
 //!
 //! Where the shapes dip between contact points, the replay is run again with the contacts held
 //! on the chords between them (`discretisation.contact: "chords"`, whatever the case says), and
-//! its equilibria, checked and confirmed the same way, are the plan if they pass.
+//! its equilibria, checked and confirmed the same way, are the plan if they pass. When no
+//! optimised path is executable, the planner checks the straight-line path's end poses the same
+//! way (`Planner::run`).
 
 use super::Planner;
 use super::observer::PlanObserver;
@@ -25,7 +27,8 @@ use crate::rod::model::Model;
 use crate::statics::StaticProblem;
 use serde::Serialize;
 
-/// The replayed equilibria along the optimal path's trajectory, as a plan.
+/// The replayed equilibria along the optimal path's trajectory (or, when no optimised path is
+/// executable, along the straight-line path's), as a plan.
 #[derive(Clone, Debug, Serialize)]
 pub struct EquilibriumPlan {
     /// The trajectory executes these shapes: every replay solve converged, every shape is
