@@ -890,6 +890,21 @@ impl Planner {
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
 
         observer.phase("replay");
+        // Along the straight path, the replay recorded the straight path's shapes as its
+        // optimal ones (logged as the straight path's already): the log's optimal path is the
+        // optimiser's.
+        if along_straight {
+            let mut a = vec![0.0; path.n()];
+            let mut sh = Shape::default();
+            judged.shapes.set_optimal(|k| {
+                path.shape_at(&chosen.z, k, &mut a);
+                model.evaluate_into(&a, &mut sh);
+                let e = model
+                    .energy(&a, &sh, self.base.objective, None)
+                    .scaled(unit);
+                (a.clone(), e, clearance(&self.base, &sh.positions))
+            });
+        }
         flush(&judged.shapes, model, observer);
         let interrupted = self.poll(observer) || self.stopped();
         let t_replay = judged.seconds;

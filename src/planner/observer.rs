@@ -139,6 +139,19 @@ impl<'a> Recorder<'a> {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct RecordedShapes(Vec<Recorded>);
 
+impl RecordedShapes {
+    /// Gives every optimal-path shape the coefficients, energy and clearance `f(k)` returns
+    /// (a replay of another path records that path's shapes as its optimal ones).
+    pub(crate) fn set_optimal(
+        &mut self,
+        mut f: impl FnMut(f64) -> (Vec<f64>, EnergyTerms, Option<f64>),
+    ) {
+        for r in self.0.iter_mut().filter(|r| r.kind == PathKind::Optimal) {
+            (r.a, r.energy, r.clearance) = f(r.k);
+        }
+    }
+}
+
 /// Tells `observer` of every shape in `shapes`, in the order they were computed.
 pub(crate) fn flush(shapes: &RecordedShapes, model: &Model, observer: &mut dyn PlanObserver) {
     for r in &shapes.0 {

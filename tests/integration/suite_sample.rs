@@ -103,9 +103,19 @@ fn suite_3d_plan(
     dlo_planner::planner::Planner,
     dlo_planner::planner::PlanResult,
 ) {
+    suite_3d_plan_observed(i, &mut dlo_planner::planner::observer::Silent)
+}
+
+/// [`suite_3d_plan`], telling `observer` of the run.
+fn suite_3d_plan_observed(
+    i: usize,
+    observer: &mut dyn dlo_planner::planner::observer::PlanObserver,
+) -> (
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::PlanResult,
+) {
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
-    use dlo_planner::planner::observer::Silent;
     let mut rng = Rng(1);
     for j in 0..68 {
         planar_problem(&mut rng, j);
@@ -117,7 +127,7 @@ fn suite_3d_plan(
     let path = format!("planning_cases/spatial_{i}.json");
     let c = case::parse(&text, std::path::Path::new(&path)).expect("a generated case");
     let p = Planner::from_case(&c).expect("start and goal solve");
-    let r = p.run(&mut Silent);
+    let r = p.run(observer);
     (p, r)
 }
 
@@ -145,7 +155,18 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
 /// path does not execute, and passes the same independent checks.
 #[test]
 fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
-    let (p, r) = suite_3d_plan(17);
+    use dlo_planner::planner::observer::{PathKind, PlanObserver, ShapeRecord};
+    /// The optimal path's shapes the run logs.
+    struct Optimal(Vec<(f64, Vec<f64>)>);
+    impl PlanObserver for Optimal {
+        fn shape(&mut self, _: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
+            if r.kind == PathKind::Optimal {
+                self.0.push((r.k, r.a.to_vec()));
+            }
+        }
+    }
+    let mut logged = Optimal(Vec::new());
+    let (p, r) = suite_3d_plan_observed(17, &mut logged);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");
@@ -163,6 +184,14 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
         for (xi, pi) in x.iter().zip(&pose.position) {
             assert!((xi * model.rod.length - pi).abs() <= 1e-9);
         }
+    }
+    // The log's optimal path is the optimiser's, at every replay step.
+    let best = p.with_terms(r.path_terms).path();
+    let mut a_best = vec![0.0; best.n()];
+    assert_eq!(logged.0.len(), r.replay.steps.len());
+    for (k, a) in &logged.0 {
+        best.shape_at(&r.z, *k, &mut a_best);
+        assert!(a.iter().zip(&a_best).all(|(x, y)| (x - y).abs() <= 1e-12));
     }
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
