@@ -72,6 +72,14 @@ pub struct EquilibriumPlan {
     pub(crate) dips: bool,
 }
 
+impl EquilibriumPlan {
+    /// Adds to [`Self::reason`] why a second attempt (`attempt`: what it changed) failed too.
+    pub(super) fn retry_failed(&mut self, attempt: &str, why: &str) {
+        let first = self.reason.take().unwrap_or_default();
+        self.reason = Some(format!("{first}; {attempt}: {why}"));
+    }
+}
+
 /// `base` with every obstacle contact held on the chords between sample points, or `None` when
 /// it has no obstacle held at its points alone.
 pub(super) fn on_chords(base: &StaticProblem) -> Option<StaticProblem> {

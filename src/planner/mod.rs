@@ -184,14 +184,7 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Constraint>) 
                     linear.push(row);
                 }
             }
-            Constraint::Obstacle(ob) => {
-                // The optimiser's sampled rows hold at the sample points (the safety margin
-                // and the verification grid keep what lies between them clear).
-                let mut o = ob.clone();
-                o.clearance += safety;
-                o.chords = false;
-                blocks.push(o.into());
-            }
+            Constraint::Obstacle(ob) => blocks.push(optimiser_obstacle(ob, safety).into()),
             // x(0) is the fixed base: constant along every path.
             Constraint::Position(pc) if pc.boundary == 0 && !model.layout.free_base => {}
             Constraint::Position(_)
@@ -294,6 +287,19 @@ fn end_shape(
         });
     }
     Ok(sol)
+}
+
+/// The optimiser's rows of obstacle `ob`: held at the sample points, `safety` (units of L)
+/// farther out (the safety margin and the verification grid keep what lies between them
+/// clear); the path optimiser and the tracking targets use them.
+fn optimiser_obstacle(
+    ob: &crate::constraints::ObstacleConstraint,
+    safety: f64,
+) -> crate::constraints::ObstacleConstraint {
+    let mut o = ob.clone();
+    o.clearance += safety;
+    o.chords = false;
+    o
 }
 
 /// Checks that the workspace can be held on `model` (its own axes, `y = 0` inside on a planar
@@ -500,14 +506,13 @@ impl Planner {
     ) -> Judged {
         let t = std::time::Instant::now();
         let mut rec = Recorder::new(observer);
-        let rep = self.replay_under(&self.base, path, z, &mut rec);
+        let mut rep = self.replay_under(&self.base, path, z, &mut rec);
         let workspace = self.workspace_check(path, z);
         let within = workspace.is_none_or(|w| w.within);
         let as_planned = planned && rep.coincide;
         let mut equilibrium_plan =
             (!as_planned && self.settings.equilibrium_plans && !self.stopped())
                 .then(|| self.equilibrium_plan(&self.base, path, z, &rep, fine, &mut rec));
-        let mut rep = rep;
         let mut shapes = rec.into_shapes();
         // Equilibria that dip between the solves' contact points: replayed again with the
         // contacts on the chords between them.
@@ -523,9 +528,8 @@ impl Planner {
                 *ep = on_chords;
                 rep = again;
                 shapes = rec.into_shapes();
-            } else if let Some(why) = on_chords.reason {
-                let first = ep.reason.take().unwrap_or_default();
-                ep.reason = Some(format!("{first}; replayed with contacts on chords: {why}"));
+            } else if let Some(why) = &on_chords.reason {
+                ep.retry_failed("replayed with contacts on chords", why);
             }
         }
         let executable = !self.stopped()
@@ -720,7 +724,7 @@ impl Planner {
         }
         crate::constraints::PositionConstraint {
             name: "workspace".into(),
-            boundary: model.boundary(1.0),
+            boundary: b,
             rows,
         }
     }
@@ -756,10 +760,28 @@ impl Planner {
         })
     }
 
+    /// The shape of `path(z)` at `k` into `a` and `shape`: its energy terms (case units) and
+    /// obstacle clearance, as the log records them.
+    fn path_shape(
+        &self,
+        path: &DeformationPath,
+        z: &[f64],
+        k: f64,
+        a: &mut [f64],
+        shape: &mut Shape,
+    ) -> (crate::rod::energy::EnergyTerms, Option<f64>) {
+        let model = &self.base.model;
+        path.shape_at(z, k, a);
+        model.evaluate_into(a, shape);
+        let e = model
+            .energy(a, shape, self.base.objective, None)
+            .scaled(model.rod.energy_unit());
+        (e, clearance(&self.base, &shape.positions))
+    }
+
     /// Optimises, verifies and replays the plan.
     pub fn run(&self, observer: &mut dyn PlanObserver) -> PlanResult {
         let model = &self.base.model;
-        let unit = model.rod.energy_unit();
         observer.begin(model);
         observer.phase("endpoints");
         for (k, sol) in [(0.0, &self.start), (1.0, &self.goal)] {
@@ -790,11 +812,7 @@ impl Planner {
             let steps = self.settings.replay_steps;
             for i in 0..=steps {
                 let k = i as f64 / steps as f64;
-                path.shape_at(&vec![0.0; nv], k, &mut a);
-                model.evaluate_into(&a, &mut sh);
-                let e = model
-                    .energy(&a, &sh, self.base.objective, None)
-                    .scaled(unit);
+                let (e, c) = self.path_shape(&path, &vec![0.0; nv], k, &mut a, &mut sh);
                 observer.shape(
                     model,
                     &ShapeRecord {
@@ -802,7 +820,7 @@ impl Planner {
                         k,
                         a: &a,
                         energy: e,
-                        clearance: clearance(&self.base, &sh.positions),
+                        clearance: c,
                         deviation: None,
                         stable: None,
                         reactions: &[],
@@ -843,7 +861,7 @@ impl Planner {
             added,
         } = runs[best].plan.clone();
         let chosen = &chosen;
-        let judged = match judged.into_iter().find(|(i, _)| *i == best) {
+        let mut judged = match judged.into_iter().find(|(i, _)| *i == best) {
             Some((_, j)) => j,
             None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
             None => self.judge(&runs[best], &fine, observer),
@@ -853,7 +871,6 @@ impl Planner {
         // them), as the plan if they pass.
         let straight_path = self.path();
         let straight_z = vec![0.0; straight_path.n_vars()];
-        let mut judged = judged;
         let mut along_straight = false;
         if !judged.executable && self.settings.equilibrium_plans && !self.stopped() {
             let mut s = self.judge_path(&straight_path, &straight_z, false, &fine, observer);
@@ -881,10 +898,7 @@ impl Planner {
                 judged.equilibrium_plan.as_mut(),
                 s.equilibrium_plan.and_then(|e| e.reason),
             ) {
-                let first = e.reason.take().unwrap_or_default();
-                e.reason = Some(format!(
-                    "{first}; along the straight path's trajectory: {why}"
-                ));
+                e.retry_failed("along the straight path's trajectory", &why);
             }
         }
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
@@ -897,12 +911,8 @@ impl Planner {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();
             judged.shapes.set_optimal(|k| {
-                path.shape_at(&chosen.z, k, &mut a);
-                model.evaluate_into(&a, &mut sh);
-                let e = model
-                    .energy(&a, &sh, self.base.objective, None)
-                    .scaled(unit);
-                (a.clone(), e, clearance(&self.base, &sh.positions))
+                let (e, c) = self.path_shape(&path, &chosen.z, k, &mut a, &mut sh);
+                (a.clone(), e, c)
             });
         }
         flush(&judged.shapes, model, observer);

@@ -43,8 +43,7 @@ impl Planner {
         let mut inflated = self.base.clone();
         for con in inflated.constraints.iter_mut() {
             if let Constraint::Obstacle(ob) = con {
-                ob.clearance += self.safety();
-                ob.chords = false;
+                *ob = super::optimiser_obstacle(ob, self.safety());
             }
         }
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of
