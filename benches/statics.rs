@@ -61,7 +61,7 @@ fn benches(c: &mut Criterion) {
     bench_solve(
         c,
         "3D twisted clamped solve (30 coefficients)",
-        &load("kinking_twist_2pi_080.json"),
+        &load("../tests/fixtures/paper_axes/kinking_twist_2pi_080.json"),
     );
     bench_solve(
         c,

@@ -13,6 +13,16 @@
 //! Euler angles' pole (`θ = 0` or `π`) over a stretch, opposite changes of `φ` and `ψ`, which
 //! move nothing. Such a pole stretch also hides bending perturbations the angles cannot express,
 //! so a shape with one is never called stable.
+//!
+//! A symmetry of the problem is removed too: when a weightless 3D rod, loaded by nothing but its
+//! constraints, is held only at points on one line (positions on it, clamps whose tangent lies
+//! along it) and touches nothing but itself, turning the whole rod about that line — the material
+//! frame turned back about the tangent so that every clamped frame is unchanged — is a family of
+//! equilibria of equal energy. Its direction is neutral in the continuum, and the Ritz fields
+//! hold it only up to their resolution, so its eigenvalue is rounding of either sign: it is
+//! taken out, and the shape is judged on the rest (see [`rotation_symmetry`]). Angles measured
+//! from the case's axes with a clamp on their pole do not hold this symmetry (the clamp's rows
+//! on `φ` and `ψ` act as a hidden support), and there nothing is removed.
 
 use crate::optim::second_order::{lagrangian_hessian_and_tangents, null_space};
 use crate::rod::layout::Field;
@@ -103,6 +113,116 @@ fn constant_coefficients(p: &StaticProblem) -> DVector<f64> {
         .unwrap_or_else(|_| DVector::zeros(nb))
 }
 
+/// The axis of a rotation symmetry of `p` at its solution `a`: a point on it and its unit
+/// direction, in the case's axes (dimensionless).
+///
+/// The problem must be 3D and weightless with no point loads, and every constraint must be a
+/// position on the line through `x(0)` along the tangent `ζ(0)`, an orientation where the
+/// tangent lies along that line, or self-contact. Obstacles, relative positions and rows on the
+/// coefficients break the symmetry. Points and tangents are judged on the solved shape, to
+/// `1e-7`.
+fn symmetry_axis(p: &StaticProblem, a: &[f64]) -> Option<([f64; 3], [f64; 3])> {
+    use crate::constraints::Constraint;
+    use crate::rod::material::Profile;
+    let m = &p.model;
+    let weightless = match m.rod.weight {
+        Profile::Constant(w) => w == 0.0,
+        Profile::Linear { start, end } => start == 0.0 && end == 0.0,
+    };
+    if !m.layout.spatial || !weightless || !m.loads.is_empty() {
+        return None;
+    }
+    let tangent = |t: f64| {
+        let f = m.frame_at(a, t);
+        [f[0][2], f[1][2], f[2][2]]
+    };
+    let origin = m.position_at(a, 0.0);
+    let u = tangent(0.0);
+    let tol = 1e-7;
+    let on_axis = |x: [f64; 3]| {
+        let d = [x[0] - origin[0], x[1] - origin[1], x[2] - origin[2]];
+        crate::rod::kinematics::cross(d, u)
+            .iter()
+            .all(|c| c.abs() <= tol)
+    };
+    let along = |t: f64| {
+        crate::rod::kinematics::cross(tangent(t), u)
+            .iter()
+            .all(|c| c.abs() <= tol)
+    };
+    let shape = m.evaluate(a);
+    for c in &p.constraints {
+        let ok = match c {
+            Constraint::Position(k) => on_axis(shape.positions[k.boundary]),
+            Constraint::Orientation(k) => along(k.t),
+            Constraint::SelfContact(_) => true,
+            Constraint::RelativePosition(_) | Constraint::Linear(_) | Constraint::Obstacle(_) => {
+                false
+            }
+        };
+        if !ok {
+            return None;
+        }
+    }
+    Some((origin, u))
+}
+
+/// The coefficient-space direction of the rotation symmetry of `p` at `a` ([`symmetry_axis`]),
+/// if it has one: the whole rod turned about the axis `u` and its material frame turned back
+/// about the tangent, `δA = [u]× A − A [ẑ]× = [u − ζ]× A`, written as changes of the Euler angles
+/// at the quadrature nodes,
+///
+/// `δθ = u·n`, `δψ = u·m / sin θ − 1`, `δφ = u_z − (u·m) cos θ / sin θ`,
+///
+/// with `m = (cos φ, sin φ, 0)`, `n = (−sin φ, cos φ, 0)` and `u` in the angles' frame, and
+/// projected on the basis in `L²`. `None` where a node lies on the pole (`sin θ < 1e-6`): there
+/// the angles cannot carry the rotation, and the pole's own gauges apply; `None` too for a rod
+/// that lies along the axis, which the rotation does not move.
+fn rotation_symmetry(p: &StaticProblem, a: &[f64]) -> Option<DVector<f64>> {
+    let (_, u) = symmetry_axis(p, a)?;
+    let m = &p.model;
+    let lay = m.layout;
+    let (op, ot) = (lay.offset(Field::Phi)?, lay.offset(Field::Theta)?);
+    let os = lay.offset(Field::Psi);
+    let u = m.to_angles(u);
+    let nb = m.nb();
+    let mut gram = DMatrix::<f64>::zeros(nb, nb);
+    let mut rhs = DMatrix::<f64>::zeros(nb, 3);
+    let mut size = 0.0;
+    for (q, (&t, &w)) in m.mesh.nodes.iter().zip(&m.mesh.weights).enumerate() {
+        let [phi, theta, _] = m.angles_at(a, t);
+        let (sf, cf) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        if st.abs() < 1e-6 {
+            return None;
+        }
+        let um = u[0] * cf + u[1] * sf;
+        let d = [u[2] - um * ct / st, -u[0] * sf + u[1] * cf, um / st - 1.0];
+        size += w * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        let e = m.e_at(q);
+        for i in 0..nb {
+            for (k, dk) in d.iter().enumerate() {
+                rhs[(i, k)] += w * e[i] * dk;
+            }
+            for j in 0..nb {
+                gram[(i, j)] += w * e[i] * e[j];
+            }
+        }
+    }
+    // A straight rod turned about its own axis does not move: no direction to remove.
+    if size.sqrt() < 1e-8 {
+        return None;
+    }
+    let x = gram.svd(true, true).solve(&rhs, 1e-12).ok()?;
+    let mut g = DVector::<f64>::zeros(a.len());
+    g.rows_mut(op, nb).copy_from(&x.column(0));
+    g.rows_mut(ot, nb).copy_from(&x.column(1));
+    if let Some(os) = os {
+        g.rows_mut(os, nb).copy_from(&x.column(2));
+    }
+    (g.norm() > 0.0).then_some(g)
+}
+
 /// Judges the static solution `(a, lambda)` of `p`.
 pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     let (hess, exact, z) = lagrangian_hessian_and_tangents(p, a, lambda, 1e-8);
@@ -132,6 +252,14 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     let gauges_psi: Vec<&DVector<f64>> = psi_shift.iter().filter(|g| is_gauge(g)).collect();
     let gauges_pole: Vec<&DVector<f64>> = pole.iter().filter(|g| is_gauge(g)).collect();
     let on_pole = !gauges_pole.is_empty();
+    let symmetry = if on_pole {
+        None
+    } else {
+        // Only where the discrete constraints hold the symmetry too: separate rows on `φ` and
+        // `ψ` at a clamp on the pole forbid it (a resolved shape leaves about 1e-5 of the
+        // direction outside the tangent space, such a clamp about 0.4).
+        rotation_symmetry(p, a).filter(|g| (g - &z * (z.transpose() * g)).norm() <= 1e-3 * g.norm())
+    };
     // The tangent basis with the gauge span taken out.
     let zg = if z.ncols() == 0 {
         z.clone()
@@ -139,7 +267,9 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
         let gs: Vec<DVector<f64>> = gauges_psi
             .iter()
             .chain(&gauges_pole)
-            .map(|g| z.transpose() * *g)
+            .copied()
+            .chain(symmetry.as_ref())
+            .map(|g| z.transpose() * g)
             .collect();
         if gs.is_empty() {
             z.clone()

@@ -195,3 +195,47 @@ fn legendre_basis_locates_greenhills_threshold() {
         );
     }
 }
+
+/// The shipped 2π kinking loop is held at two points of one line, its clamps along it and
+/// weightless: turned about that line as a whole (the material frame turned back about the
+/// tangent), it is an equilibrium of the same energy, and that turn is neutral. The verdict
+/// takes it out (`gauge_modes` 1) and judges the rest: stable, smallest eigenvalue above 1
+/// Rf/L. Moving the far end off the line by δ breaks the symmetry: nothing is removed, and the
+/// smallest eigenvalue is the turn's own stiffness, which vanishes with δ — proportional to it
+/// (δ = 0.01 L and 0.001 L: ratio 10 within 5 %), below 5 % of the rest's at both. So the
+/// direction removed is the one that becomes neutral, not a stiff mode hidden from the verdict.
+#[test]
+fn a_loop_free_to_turn_about_its_clamps_line_is_judged_on_the_rest() {
+    use dlo_planner::statics::stability::Verdict;
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases/kinking_twist_2pi_080.json");
+    let shipped: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let judged = |offset: f64| {
+        let mut v = shipped.clone();
+        v["constraints"][1]["x"] = serde_json::json!(offset);
+        let mut c = case::parse(&v.to_string(), Path::new("kinking_offset.json")).unwrap();
+        let sol = solve_static(&mut c.problem, &c.initial, &c.options);
+        assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+        sol
+    };
+    let on_line = judged(0.0);
+    assert_eq!(on_line.stability, Some(Verdict::Stable));
+    assert_eq!(on_line.gauge_modes, Some(1));
+    let rest = on_line.min_reduced_eigenvalue.unwrap();
+    assert!(rest > 1.0, "{rest}");
+    let mut turn = Vec::new();
+    for offset in [1.0, 0.1] {
+        let sol = judged(offset);
+        assert_eq!(sol.gauge_modes, Some(0), "δ = {offset}");
+        assert_eq!(sol.stability, Some(Verdict::Stable), "δ = {offset}");
+        let lo = sol.min_reduced_eigenvalue.unwrap();
+        assert!(
+            lo > 0.0 && lo < 0.05 * rest,
+            "δ = {offset}: {lo} against {rest}"
+        );
+        turn.push(lo);
+    }
+    let ratio = turn[0] / turn[1];
+    assert!((ratio - 10.0).abs() < 0.5, "{turn:?}");
+}
