@@ -432,7 +432,17 @@ fn farthest_on_sphere(lines: &[([f64; 3], f64)]) -> [f64; 3] {
 /// The case's orientation constraints as rows on the angles of `r` (see the module
 /// documentation), in the order of `file.constraints`; `None` for one that is not an
 /// orientation.
-pub(crate) fn convert(file: &CaseFile, r: [[f64; 3]; 3]) -> Vec<Option<Vec<(Angle, f64)>>> {
+///
+/// With `start` (the written start's angles in `r` at arc length `s`), each orientation takes
+/// instead the spelling nearest the start's angles there: the start says which turns the user
+/// means (a loop whose tangent circles the angles' axis has `φ(L) = φ(0) − 2π` where the written
+/// angles interpolate no turn at all), and a branch the start does not hold would make the
+/// solve unwind it.
+pub(crate) fn convert(
+    file: &CaseFile,
+    r: [[f64; 3]; 3],
+    start: Option<&dyn Fn(f64) -> [f64; 3]>,
+) -> Vec<Option<Vec<(Angle, f64)>>> {
     let frame = (!is_identity(&r)).then_some(r);
     let mut order: Vec<(usize, f64, Written)> = file
         .constraints
@@ -447,15 +457,19 @@ pub(crate) fn convert(file: &CaseFile, r: [[f64; 3]; 3]) -> Vec<Option<Vec<(Angl
     // The written angles (ψ filled in from the previous where a tangent leaves it) and their
     // angles in `r`, of the previous constraint.
     let mut prev: Option<([f64; 3], [f64; 3])> = None;
-    for (i, _, w) in order {
+    for (i, s, w) in order {
         let written = match (w, prev) {
             (Written::Frame(a), _) => a,
             (Written::Tangent([f, t]), Some((p, _))) => [f, t, p[2]],
             (Written::Tangent([f, t]), None) => [f, t, 0.0],
         };
-        let angles = match prev {
-            None => angles_of(local(written)),
-            Some((pw, pl)) => {
+        let angles = match (start, prev) {
+            (Some(start), _) => {
+                let tangent_only = matches!(w, Written::Tangent(_));
+                nearest_branch_of(angles_of(local(written)), start(s), !tangent_only)
+            }
+            (None, None) => angles_of(local(written)),
+            (None, Some((pw, pl))) => {
                 // Continue along the written angles' interpolation, step by step.
                 let steps = 256;
                 let mut cur = pl;
@@ -486,15 +500,22 @@ pub(crate) fn convert(file: &CaseFile, r: [[f64; 3]; 3]) -> Vec<Option<Vec<(Angl
 /// The spelling of the rotation with angles `a` — `(φ, θ, ψ)` or `(φ + π, −θ, ψ + π)`, each
 /// angle plus any multiple of 2π — nearest `reference`.
 fn nearest_branch(a: [f64; 3], reference: [f64; 3]) -> [f64; 3] {
+    nearest_branch_of(a, reference, true)
+}
+
+/// [`nearest_branch`], judging the distance on `(φ, θ)` alone unless `with_psi` (a tangent
+/// leaves `ψ` free).
+fn nearest_branch_of(a: [f64; 3], reference: [f64; 3], with_psi: bool) -> [f64; 3] {
+    let dist = |x: [f64; 3]| {
+        (0..if with_psi { 3 } else { 2 })
+            .map(|j| (x[j] - reference[j]).abs())
+            .fold(0.0, f64::max)
+    };
     [a, [a[0] + PI, -a[1], a[2] + PI]]
         .map(|b| std::array::from_fn::<f64, 3, _>(|j| nearest(b[j], reference[j])))
         .into_iter()
-        .min_by(|x, y| dist(*x, reference).total_cmp(&dist(*y, reference)))
+        .min_by(|x, y| dist(*x).total_cmp(&dist(*y)))
         .expect("two spellings")
-}
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (0..3).map(|j| (a[j] - b[j]).abs()).fold(0.0, f64::max)
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -573,9 +573,29 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     // The angles' reference frame, away from the pole where the case allows it, and the
     // orientation constraints written in it.
     let angle_frame = frame::choose(&file).map_err(|m| v.err("angle_frame", m))?;
+    let start = match &file.shape {
+        Some(sh) => Some(coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?),
+        None => None,
+    };
+    // A written start's angles at `s` pick the branch of each converted orientation.
+    let start_angles = start.as_ref().map(|a| {
+        let layout = &layout;
+        move |s: f64| {
+            let f = |field| {
+                layout
+                    .field(a, field)
+                    .map_or(0.0, |c| layout.basis.eval(c, s / l))
+            };
+            [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
+        }
+    });
     let converted = angle_frame.map(|r| {
         builder = builder.clone().angle_frame(r);
-        frame::convert(&file, r)
+        frame::convert(
+            &file,
+            r,
+            start_angles.as_ref().map(|f| f as &dyn Fn(f64) -> [f64; 3]),
+        )
     });
 
     // Fixed points for the reachability check: (t, position, all components fixed).
@@ -778,11 +798,8 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         .clone()
         .build()
         .map_err(|e| v.err("constraints", e.to_string()))?;
-    let (initial, explicit_shape) = match &file.shape {
-        Some(sh) => (
-            coefficients(&v, "shape", sh, &layout, base.map(|c| c / l))?,
-            true,
-        ),
+    let (initial, explicit_shape) = match start {
+        Some(a) => (a, true),
         None => {
             let mut a = default_start(&layout, file.solver.perturbation, base.map(|c| c / l));
             // Along the held end's orientation in the angles' frame.

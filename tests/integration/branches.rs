@@ -239,3 +239,30 @@ fn a_loop_free_to_turn_about_its_clamps_line_is_judged_on_the_rest() {
     let ratio = turn[0] / turn[1];
     assert!((ratio - 10.0).abs() < 0.5, "{turn:?}");
 }
+
+/// The shipped knot's start is a loop whose tangent circles the angles' axis: its angles end
+/// 2π below where they begin, where the written clamps (the same frame at both ends) interpolate
+/// no turn at all. The end's angles take the branch the start holds, so the solve stays on the
+/// start's loop: the converged energy is within 1e-8 of the start's (which is the resolved
+/// shape), and φ and ψ keep their turn of −2π to 1e-9. (With the interpolated branch the solve
+/// unwinds them and ends on another shape: U 0.3537 against 0.3497.)
+#[test]
+fn a_written_start_picks_the_branch_of_the_end_angles() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases/topology_one_knot_020.json");
+    let mut c = case::load(&path).unwrap();
+    let initial = c.initial.clone();
+    let start = dlo_planner::statics::evaluate_shape(&mut c.problem, &initial)
+        .energy
+        .potential();
+    let sol = solve_static(&mut c.problem, &c.initial, &c.options);
+    assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
+    let u = sol.energy.potential();
+    assert!((u - start).abs() <= 1e-8 * start, "{u} from {start}");
+    let m = &c.problem.model;
+    let (a0, a1) = (m.angles_at(&sol.a, 0.0), m.angles_at(&sol.a, 1.0));
+    let two_pi = 2.0 * std::f64::consts::PI;
+    for k in [0, 2] {
+        assert!((a1[k] - a0[k] + two_pi).abs() < 1e-9, "{a0:?} → {a1:?}");
+    }
+}
