@@ -20,7 +20,7 @@
 //! frame turned back about the tangent so that every clamped frame is unchanged — is a family of
 //! equilibria of equal energy. Its direction is neutral in the continuum, and the Ritz fields
 //! hold it only up to their resolution, so its eigenvalue is rounding of either sign: it is
-//! taken out, and the shape is judged on the rest (see [`rotation_symmetry`]). Angles measured
+//! taken out, and the shape is judged on the rest (see `rotation_symmetry` in this file). Angles measured
 //! from the case's axes with a clamp on their pole do not hold this symmetry (the clamp's rows
 //! on `φ` and `ψ` act as a hidden support), and there nothing is removed.
 
