@@ -91,8 +91,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let planner = Planner::new(PlanProblem::new(held, start, goal), PlanSettings::default())?;
     let plan = planner.run(&mut Silent);
     println!(
-        "plan: {}, U_max {:.4} (straight path {:.4}), clearance {:.4} (straight path {:.4}), replay {} (largest deviation {:.2e} L)",
+        "plan: {} ({}), U_max {:.4} (straight path {:.4}), clearance {:.4} (straight path {:.4}), the optimal path's replay {} (largest deviation {:.2e} L)",
         plan.verdict(),
+        match plan.executed_path() {
+            Some(p) => format!("executed: {p}"),
+            None => "nothing to execute".into(),
+        },
         plan.u_max,
         plan.u_max_straight,
         plan.min_clearance.unwrap_or(f64::NAN),

@@ -26,7 +26,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=7, help="rounds, alternating the sides")
     args = ap.parse_args()
     rod = dlo.Rod(length=100.0, flexural_rigidity=1.0, radius=0.05)
-    problem = dlo.StaticProblem(rod).position(100.0, name="right pin", equal={"x": 0.0, "z": 80.0})
+    problem = dlo.StaticProblem(rod, basis="paper").position(100.0, name="right pin", equal={"x": 0.0, "z": 80.0})
 
     def python(points, read):
         times = []

@@ -93,15 +93,16 @@ class Obstacle:
 
 class StaticProblem:
     """A rod's static problem: conditions at arc lengths, loads, obstacles, self-contact.
-    Methods that add to it return the problem, so calls chain. ``basis`` is ``"paper"`` (the
-    paper's ``1, s/L, sin, cos``) or ``"legendre"``; ``contact`` is where obstacle contacts are
+    Methods that add to it return the problem, so calls chain. ``basis`` is ``"legendre"`` (the
+    default: ``1, s/L`` and Legendre polynomials in ``s/L``) or ``"paper"`` (the paper's ``1,
+    s/L, sin, cos``); ``contact`` is where obstacle contacts are
     held: ``"points"`` (the sample points) or ``"chords"`` (the chords between them)."""
 
     def __init__(
         self,
         rod: Rod,
         basis_pairs: int = 4,
-        basis: Literal["paper", "legendre"] = "paper",
+        basis: Literal["paper", "legendre"] = "legendre",
         panels: int = 16,
         gauss_points: int = 4,
         samples: int = 32,

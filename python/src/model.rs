@@ -277,7 +277,7 @@ pub struct StaticProblem {
 #[pymethods]
 impl StaticProblem {
     #[new]
-    #[pyo3(signature = (rod, basis_pairs=4, basis="paper", panels=16, gauss_points=4, samples=32, base=[0.0; 3], free_base=false, contact="points"))]
+    #[pyo3(signature = (rod, basis_pairs=4, basis="legendre", panels=16, gauss_points=4, samples=32, base=[0.0; 3], free_base=false, contact="points"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         rod: &Rod,

@@ -11,9 +11,9 @@ from conftest import CASES, cli_json
 
 def pinned_elastica() -> dlo.StaticProblem:
     """`planning_cases/pinned_buckling_080.json` built in code: L = 100, Rf = 1, both ends
-    pinned 0.80 L apart."""
+    pinned 0.80 L apart, in the paper's basis as the case names it."""
     rod = dlo.Rod(length=100.0, flexural_rigidity=1.0, radius=0.05)
-    return dlo.StaticProblem(rod).position(100.0, name="right pin", equal={"x": 0.0, "z": 80.0})
+    return dlo.StaticProblem(rod, basis="paper").position(100.0, name="right pin", equal={"x": 0.0, "z": 80.0})
 
 
 def test_pinned_elastica_force_equals_the_cli(dlo_bin, tmp_path):
@@ -100,10 +100,11 @@ def test_a_cable_sags_onto_a_ball():
 
 
 def test_a_grasp_built_in_code_equals_the_case():
-    # planning_cases/grasp_a_080.json in code: fingers are positions with one bound.
+    # planning_cases/grasp_a_080.json in code (the paper's basis, as the case names it):
+    # fingers are positions with one bound.
     rod = dlo.Rod(length=100.0, flexural_rigidity=1.0, radius=0.05)
     grasp = (
-        dlo.StaticProblem(rod, free_base=True)
+        dlo.StaticProblem(rod, basis="paper", free_base=True)
         .position(0.0, name="left finger", equal={"x": 0.0}, at_least={"z": 0.0})
         .position(100.0, name="right finger", equal={"x": 0.0}, at_most={"z": 80.0})
     )

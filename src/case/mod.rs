@@ -107,8 +107,10 @@ pub struct RodSpec {
 pub struct DiscretisationSpec {
     /// Sine/cosine pairs per field (paper: 4, i.e. 10 functions).
     pub basis_pairs: usize,
-    /// The functions: `"paper"` (default) or `"legendre"`.
-    pub basis: crate::rod::basis::BasisKind,
+    /// The functions: `"legendre"` or `"paper"`. Unnamed: `"legendre"`, but for a case that
+    /// writes Ritz coefficients (a `shape`, top level or in a plan end), which are read in the
+    /// paper's basis as they always were.
+    pub basis: Option<crate::rod::basis::BasisKind>,
     /// Uniform quadrature panels.
     pub panels: usize,
     /// Gauss points per panel.
@@ -135,7 +137,7 @@ impl Default for DiscretisationSpec {
     fn default() -> Self {
         DiscretisationSpec {
             basis_pairs: 4,
-            basis: crate::rod::basis::BasisKind::Paper,
+            basis: None,
             panels: 16,
             gauss_points: 4,
             samples: 32,
@@ -524,7 +526,7 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
         radius,
     };
     let layout = Layout {
-        basis: Basis::new(d.basis_pairs).of_kind(d.basis),
+        basis: Basis::new(d.basis_pairs).of_kind(basis_of(&file)),
         spatial: !file.planar,
         extensible: r.extensional_rigidity.is_some(),
         free_base: file.base.free,
@@ -926,6 +928,23 @@ fn build_shape(
             let n = v.vec3(&format!("{field}.normal"), *normal)?;
             ObstacleShape::half_space(n).map_err(|m| v.err(format!("{field}.normal"), m))?
         }
+    })
+}
+
+/// The basis `file` names, or its default: Legendre polynomials, but the paper's functions for
+/// a case that writes Ritz coefficients without naming their basis.
+pub(crate) fn basis_of(file: &CaseFile) -> crate::rod::basis::BasisKind {
+    use crate::rod::basis::BasisKind;
+    let writes = file.shape.is_some()
+        || file.plan.as_ref().is_some_and(|p| {
+            ["start", "goal"]
+                .iter()
+                .any(|k| p.get(*k).is_some_and(|e| e.get("shape").is_some()))
+        });
+    file.discretisation.basis.unwrap_or(if writes {
+        BasisKind::Paper
+    } else {
+        BasisKind::Legendre
     })
 }
 

@@ -33,11 +33,13 @@ pub struct Layout {
 }
 
 impl Layout {
-    /// The layout for `rod` with `pairs` sine–cosine pairs of the paper's basis: 3D when the
-    /// rod has a torsional rigidity, extensible when it has an extensional one, base fixed.
+    /// The layout for `rod` with `2 + 2·pairs` Legendre polynomials per field (the default
+    /// basis, as in case files; `layout.basis = Basis::new(pairs)` gives the paper's `pairs`
+    /// sine–cosine pairs instead): 3D when the rod has a torsional rigidity, extensible when it
+    /// has an extensional one, base fixed.
     pub fn of(rod: &crate::rod::Rod, pairs: usize) -> Layout {
         Layout {
-            basis: Basis::new(pairs),
+            basis: Basis::new(pairs).of_kind(crate::rod::basis::BasisKind::Legendre),
             spatial: rod.torsional.is_some(),
             extensible: rod.extensional.is_some(),
             free_base: false,

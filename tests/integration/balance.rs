@@ -112,7 +112,7 @@ fn a_3d_shape_balances_better_as_the_basis_grows() {
         format!(
             r#"{{ "name": "generic", "planar": false, "angle_frame": "{frame}",
   "rod": {{ "length": 100.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.7 }},
-  "discretisation": {{ "basis_pairs": {pairs} }},
+  "discretisation": {{ "basis": "paper", "basis_pairs": {pairs} }},
   "constraints": [
     {{ "type": "orientation", "s": 0.0, "phi": 0.0, "theta": 1.5707963267948966, "psi": 0.0 }},
     {{ "type": "position", "s": 100.0, "x": 60.0, "y": 20.0, "z": 15.0 }},

@@ -14,6 +14,7 @@ fn solve_json(text: &str, start: Option<Vec<f64>>) -> (case::Case, StaticSolutio
 fn clamped(l_over_len: f64, rod_extra: &str) -> String {
     format!(
         r#"{{"rod": {{"length": 100.0, "flexural_rigidity": 1.0 {rod_extra}}},
+           "discretisation": {{"basis": "paper"}},
            "constraints": [
              {{"type": "orientation", "s": 0.0, "theta": 0.0}},
              {{"type": "position", "s": 100.0, "x": 0.0, "z": {z}}},

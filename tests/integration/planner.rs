@@ -507,7 +507,14 @@ fn free_swing_coincides() {
 #[test]
 fn twin_shapes_need_the_end_pulled_straight() {
     let pose = r#"{ "x": 0.45, "z": 0.8, "theta": 0.0 }"#;
-    let text = plan_text(pose, pose, "");
+    // In the paper's basis, where θ(L − s) has the coefficients below.
+    let in_paper_basis = |t: String| {
+        t.replace(
+            r#""constraints""#,
+            r#""discretisation": { "basis": "paper" }, "constraints""#,
+        )
+    };
+    let text = in_paper_basis(plan_text(pose, pose, ""));
     let c = case::parse(&text, Path::new("twin.json")).unwrap();
     let p = Planner::from_case(&c).unwrap();
     // θ(L − s): [a0 + a1, −a1, −b_i, c_i] in the basis 1, t, sin 2πit, cos 2πit.
@@ -523,7 +530,7 @@ fn twin_shapes_need_the_end_pulled_straight() {
         serde_json::to_string(&twin).unwrap()
     );
     let run = |extra: &str| {
-        let text = plan_text(pose, &goal, "")
+        let text = in_paper_basis(plan_text(pose, &goal, ""))
             .replace(r#""k_samples": 21"#, &format!(r#""k_samples": 21{extra}"#));
         let c = case::parse(&text, Path::new("twin.json")).unwrap();
         let p = Planner::from_case(&c).unwrap();

@@ -22,11 +22,10 @@ fn first(generate: fn(&mut Rng, usize) -> String, kind: &str, n: usize) -> Vec<O
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
 /// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
-/// is called coinciding. Two planar problems coincide with their replay (`planar_0`,
-/// `planar_2`), and must keep doing so; the third departs by 8 % of L, and its replayed
-/// equilibria are not a plan (a replay on twice as many steps snaps through): the suite's
-/// shortfall that docs/results.md reports. The 3D plans, untracked by default, depart by 5 %
-/// and 6 %, and their replayed equilibria are the executable plans.
+/// is called coinciding. The first planar problem coincides with its replay (`planar_0`) and
+/// must keep doing so; the next two depart by 2.2 % and 2.9 % of L, and their replayed
+/// equilibria are the executable plans. The 3D plans, untracked by default, depart by 5 % and
+/// 6 %, and their replayed equilibria are the executable plans.
 #[test]
 fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
     let planar = first(planar_problem, "planar", 3);
@@ -49,19 +48,19 @@ fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
         }
     }
     for o in planar.iter().chain(&spatial) {
-        if ["planar_0", "planar_2"].contains(&o.name.as_str()) {
+        if o.name == "planar_0" {
             assert!(o.coincide, "{}: departs by {:.4} L", o.name, o.deviation);
         }
         // Executable as optimised exactly when it coincides; by its replayed equilibria
-        // otherwise (both 3D problems, whose untracked optimal paths depart by 5 % and 6 %).
+        // otherwise.
         assert_eq!(o.executable && !o.by_equilibria, o.coincide, "{}", o.name);
-        if o.name.starts_with("spatial") {
+        if o.name != "planar_0" {
             assert!(o.executable && o.by_equilibria, "{}", o.name);
         }
     }
 }
 
-/// The suite's eighth planar problem (seed 1), planned with the defaults: its optimal path is
+/// The suite's third planar problem (seed 1), planned with the defaults: its optimal path is
 /// collision-free but its replay departs by 2.2 % of L, so the plan the gripper executes is the
 /// replayed equilibria along the optimal path's trajectory. Checked independently of the
 /// planner's own checks: every replayed shape is held at the trajectory's pose (its end's
@@ -74,11 +73,11 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
     let mut rng = Rng(1);
-    let text = (0..=7)
+    let text = (0..=2)
         .map(|i| planar_problem(&mut rng, i))
         .last()
-        .expect("eight problems");
-    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_7.json"))
+        .expect("three problems");
+    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_2.json"))
         .expect("a generated case");
     let p = Planner::from_case(&c).expect("start and goal solve");
     let r = p.run(&mut Silent);

@@ -99,7 +99,7 @@ fn spelled(rod: Value, e0: [f64; 3], p1: [f64; 3], e1: [f64; 3], q: M, extra: Va
     let l = rod["length"].as_f64().unwrap();
     let mut c = json!({
         "name": "turned", "planar": false, "rod": rod,
-        "discretisation": { "basis_pairs": 8, "panels": 32 },
+        "discretisation": { "basis": "paper", "basis_pairs": 8, "panels": 32 },
         "constraints": [
             { "type": "orientation", "s": 0.0, "phi": e0[0], "theta": e0[1], "psi": e0[2] },
             { "type": "position", "s": l, "x": p[0], "y": p[1], "z": p[2] },
@@ -217,7 +217,8 @@ fn crossed_loop_turned_about_any_axis_is_the_same() {
     let rod = shipped["rod"].clone();
     // The shipped spelling: θ runs from π/2 to 3π/2, through the apex along −z.
     let (e0, e1) = ([0.0, PI / 2.0, 0.0], [0.0, 1.5 * PI, 0.0]);
-    let extra = json!({ "self_contact": true, "discretisation": { "basis_pairs": 4 } });
+    let extra =
+        json!({ "self_contact": true, "discretisation": { "basis": "paper", "basis_pairs": 4 } });
     let id = turn([1.0, 0.0, 0.0], 0.0);
     let (c0, s0) = solve(&spelled(
         rod.clone(),
