@@ -190,24 +190,19 @@ fn gravity_arch_stays_a_minimum_up_to_rho_g_100_and_is_gone_by_120() {
     }
 }
 
+/// The text of case file `name` in the folder `dir` of the repository.
+fn case_text(dir: &str, name: &str) -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir).join(name)).unwrap()
+}
+
 fn shipped(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("planning_cases")
-            .join(name),
-    )
-    .unwrap()
+    case_text("planning_cases", name)
 }
 
 /// The paper's kinking and knot cases in its basis and axes (`tests/fixtures/paper_axes`: the
 /// shipped ones are resolved away from the Euler angles' pole).
 fn paper_axes(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/fixtures/paper_axes")
-            .join(name),
-    )
-    .unwrap()
+    case_text("tests/fixtures/paper_axes", name)
 }
 
 /// The §4.3 cases with the end distance replaced: the paper-axes loops, the shipped knot-free
