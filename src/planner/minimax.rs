@@ -37,6 +37,8 @@ pub struct MinimaxProblem {
     pub beta: f64,
     /// Weight of the mean energy.
     pub mean_weight: f64,
+    /// Weight of the controlled end's travel term ([`MinimaxProblem::travel`]).
+    pub travel_weight: f64,
     /// Energy minimised.
     pub objective: Objective,
     /// Weight of the equilibrium-tracking term.
@@ -96,6 +98,7 @@ impl MinimaxProblem {
             blocks,
             beta: 1.0,
             mean_weight: 0.0,
+            travel_weight: 0.0,
             objective,
             track_weight: 0.0,
             targets: None,
@@ -219,6 +222,43 @@ impl MinimaxProblem {
         worst
     }
 
+    /// The travel term at the last evaluated point: `½ w Σⱼ |x(kⱼ₊₁) − x(kⱼ)|² / (kⱼ₊₁ − kⱼ)`
+    /// over the controlled end's positions `x(k)` (dimensionless) at the samples, the discrete
+    /// `½ w ∫ |dx/dk|² dk`. By Cauchy–Schwarz it bounds `½ w` times the squared length of the
+    /// end's path, and it is least for a straight path at even speed.
+    pub fn travel(&self) -> f64 {
+        if self.travel_weight == 0.0 {
+            return 0.0;
+        }
+        let end = self.model.mesh.boundaries.len() - 1;
+        let mut sum = 0.0;
+        for j in 0..self.ks.len().saturating_sub(1) {
+            let (x0, x1) = (
+                self.shapes[j].positions[end],
+                self.shapes[j + 1].positions[end],
+            );
+            let d2 = (0..3).map(|c| (x1[c] - x0[c]).powi(2)).sum::<f64>();
+            sum += d2 / (self.ks[j + 1] - self.ks[j]);
+        }
+        0.5 * self.travel_weight * sum
+    }
+
+    /// `∂(travel)/∂x(kⱼ)` for sample `j` (zero at the path's ends, which are fixed).
+    fn travel_cotangent(&self, j: usize) -> [f64; 3] {
+        let end = self.model.mesh.boundaries.len() - 1;
+        let x = |i: usize| self.shapes[i].positions[end];
+        let mut d = [0.0; 3];
+        if self.travel_weight == 0.0 || j == 0 || j + 1 >= self.ks.len() {
+            return d;
+        }
+        let (back, ahead) = (self.ks[j] - self.ks[j - 1], self.ks[j + 1] - self.ks[j]);
+        let (xp, xj, xn) = (x(j - 1), x(j), x(j + 1));
+        for c in 0..3 {
+            d[c] = self.travel_weight * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead);
+        }
+        d
+    }
+
     /// The tracking term at the last evaluated point.
     pub fn tracking(&self) -> f64 {
         let Some(t) = &self.targets else { return 0.0 };
@@ -269,7 +309,10 @@ impl Nlp for MinimaxProblem {
         let mut row = 0;
         // Shapes may be left out only while nothing but the rows reads them (no tracking term,
         // no swept rows, which may have been turned on after skipping was).
-        let light = self.targets.is_none() && self.swept.is_none() && self.skip.is_some();
+        let light = self.targets.is_none()
+            && self.swept.is_none()
+            && self.travel_weight == 0.0
+            && self.skip.is_some();
         // The samples' coefficients, which shapes stay left out, then the other shapes.
         let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
@@ -329,7 +372,7 @@ impl Nlp for MinimaxProblem {
         }
         let s = smoothed_max(&self.u, self.beta, &mut self.weights);
         let mean = self.u.iter().sum::<f64>() / self.u.len() as f64;
-        s + self.mean_weight * mean + self.tracking()
+        s + self.mean_weight * mean + self.tracking() + self.travel()
     }
     fn gradient(&mut self, z: &[f64], y: &[f64], g: &mut [f64]) {
         let _ = z;
@@ -363,7 +406,8 @@ impl Nlp for MinimaxProblem {
                 });
                 let yj = &yeff;
                 let tracked = self.targets.is_some() && self.track_weight > 0.0;
-                if tracked || swept_any || yj.iter().any(|v| *v != 0.0) {
+                let travel = self.travel_weight != 0.0;
+                if tracked || travel || swept_any || yj.iter().any(|v| *v != 0.0) {
                     for (b, blk) in self.blocks.iter().enumerate() {
                         let w = &yj[self.offsets[b]..self.offsets[b + 1]];
                         if w.iter().any(|v| *v != 0.0) {
@@ -383,6 +427,11 @@ impl Nlp for MinimaxProblem {
                             self.adj
                                 .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
                         }
+                    }
+                    if travel {
+                        let end = self.model.mesh.boundaries.len() - 1;
+                        let d = self.travel_cotangent(j);
+                        self.adj.add_pos(end, 1.0, d);
                     }
                     self.adj.finish(&self.model, &self.shapes[j], &mut self.ga);
                 }
@@ -447,6 +496,16 @@ impl Nlp for MinimaxProblem {
                 }
                 model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
             }
+            if self.travel_weight != 0.0 {
+                let end = model.mesh.boundaries.len() - 1;
+                let x = |i: usize| self.shapes[i].positions[end];
+                let (back, ahead) = (k - self.ks[j - 1], self.ks[j + 1] - k);
+                let (xp, xj, xn) = (x(j - 1), x(j), x(j + 1));
+                let d: [f64; 3] = std::array::from_fn(|c| {
+                    self.travel_weight * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead)
+                });
+                self.adj.add_pos(end, 1.0, d);
+            }
             self.adj.finish_hessian(model, shape, ha);
             let sj = &s[row..row + per];
             add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut self.adj, ha);
@@ -467,6 +526,37 @@ impl Nlp for MinimaxProblem {
                 &s[ns..],
                 h,
             );
+        }
+        // The travel term's Gauss–Newton part: for each interval, `w/Δk DᵀD` with `D` the
+        // z-Jacobian of `x(kⱼ₊₁) − x(kⱼ)` (the path's ends are fixed and contribute none).
+        if self.travel_weight != 0.0 {
+            let end = self.model.mesh.boundaries.len() - 1;
+            let jac: Vec<Option<[Vec<f64>; 3]>> = (0..self.ks.len())
+                .map(|j| {
+                    let k = self.ks[j];
+                    (k > 0.0 && k < 1.0).then(|| {
+                        let rows = self.model.position_jacobian(&self.shapes[j], end);
+                        rows.map(|r| {
+                            let mut out = vec![0.0; nv];
+                            self.path.add_chain(&r, k, &mut out);
+                            out
+                        })
+                    })
+                })
+                .collect();
+            for j in 0..self.ks.len().saturating_sub(1) {
+                let w = self.travel_weight / (self.ks[j + 1] - self.ks[j]);
+                for c in 0..3 {
+                    let mut d = vec![0.0; nv];
+                    if let Some(r) = &jac[j + 1] {
+                        d.iter_mut().zip(&r[c]).for_each(|(v, x)| *v += x);
+                    }
+                    if let Some(r) = &jac[j] {
+                        d.iter_mut().zip(&r[c]).for_each(|(v, x)| *v -= x);
+                    }
+                    add_rank_one(h, w, &d);
+                }
+            }
         }
         for (j, g) in gz.iter().enumerate() {
             add_rank_one(h, self.beta * self.weights[j], g);

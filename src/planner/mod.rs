@@ -692,6 +692,7 @@ impl Planner {
             self.base.objective,
         );
         p.mean_weight = self.settings.mean_weight;
+        p.travel_weight = self.settings.travel_weight;
         p.set_swept(self.settings.swept_clearance);
         p.set_skip_clear_samples(true);
         p

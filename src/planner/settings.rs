@@ -28,6 +28,11 @@ pub struct PlanSettings {
     pub safety_margin: Option<f64>,
     /// Weight of the mean energy along the path in the objective (see the README).
     pub mean_weight: f64,
+    /// Weight of the controlled end's travel in the objective, `½ w ∫ |dx/dk|² dk` with `x` in
+    /// units of `L` (energies are in `Rf/L`): a tie-break that keeps the gripper's path short
+    /// and even among paths of nearly equal peak energy. Default 0 (`docs/results.md` gives
+    /// what other weights do on the generated suite).
+    pub travel_weight: f64,
     /// Weight of the equilibrium-tracking term (0 = the paper's objective alone). Default
     /// (absent): 10,000 on a planar rod, 0 on a 3D rod (see [`PlanSettings::tracking_weight`]).
     pub equilibrium_weight: Option<f64>,
@@ -112,6 +117,7 @@ impl Default for PlanSettings {
             verify_s_samples: d_vs(),
             safety_margin: None,
             mean_weight: d_mean(),
+            travel_weight: 0.0,
             equilibrium_weight: None,
             equilibrium_rounds: d_rounds(),
             equilibrium_stop: d_track_stop(),
@@ -210,6 +216,9 @@ impl PlanSettings {
         }
         if finite("mean_weight", self.mean_weight)? < 0.0 {
             return Err(bad("mean_weight", "must be non-negative"));
+        }
+        if finite("travel_weight", self.travel_weight)? < 0.0 {
+            return Err(bad("travel_weight", "must be non-negative"));
         }
         if let Some(w) = self.equilibrium_weight
             && finite("equilibrium_weight", w)? < 0.0
