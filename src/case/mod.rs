@@ -582,14 +582,7 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     // A written start's angles at `s` pick the branch of each converted orientation.
     let start_angles = start.as_ref().map(|a| {
         let layout = &layout;
-        move |s: f64| {
-            let f = |field| {
-                layout
-                    .field(a, field)
-                    .map_or(0.0, |c| layout.basis.eval(c, s / l))
-            };
-            [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
-        }
+        move |s: f64| layout.angles_at(a, s / l)
     });
     let converted = angle_frame.map(|r| {
         builder = builder.clone().angle_frame(r);

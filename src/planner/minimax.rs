@@ -243,22 +243,6 @@ impl MinimaxProblem {
         0.5 * self.travel_weight * sum
     }
 
-    /// `∂(travel)/∂x(kⱼ)` for sample `j` (zero at the path's ends, which are fixed).
-    fn travel_cotangent(&self, j: usize) -> [f64; 3] {
-        let end = self.model.mesh.boundaries.len() - 1;
-        let x = |i: usize| self.shapes[i].positions[end];
-        let mut d = [0.0; 3];
-        if self.travel_weight == 0.0 || j == 0 || j + 1 >= self.ks.len() {
-            return d;
-        }
-        let (back, ahead) = (self.ks[j] - self.ks[j - 1], self.ks[j + 1] - self.ks[j]);
-        let (xp, xj, xn) = (x(j - 1), x(j), x(j + 1));
-        for c in 0..3 {
-            d[c] = self.travel_weight * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead);
-        }
-        d
-    }
-
     /// The tracking term at the last evaluated point.
     pub fn tracking(&self) -> f64 {
         let Some(t) = &self.targets else { return 0.0 };
@@ -272,6 +256,19 @@ impl MinimaxProblem {
         }
         0.5 * self.track_weight * sum
     }
+}
+
+/// `∂(travel)/∂x(kⱼ)` of the travel term with weight `w` ([`MinimaxProblem::travel`]) for
+/// sample `j` of `ks`, whose evaluated `shapes` end at boundary `end` (zero at the path's ends,
+/// which are fixed).
+fn travel_cotangent(w: f64, ks: &[f64], shapes: &[Shape], end: usize, j: usize) -> [f64; 3] {
+    if w == 0.0 || j == 0 || j + 1 >= ks.len() {
+        return [0.0; 3];
+    }
+    let x = |i: usize| shapes[i].positions[end];
+    let (back, ahead) = (ks[j] - ks[j - 1], ks[j + 1] - ks[j]);
+    let (xp, xj, xn) = (x(j - 1), x(j), x(j + 1));
+    std::array::from_fn(|c| w * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead))
 }
 
 /// `S_β(u)` and its weights `∂S/∂u_j` (a softmax).
@@ -430,7 +427,8 @@ impl Nlp for MinimaxProblem {
                     }
                     if travel {
                         let end = self.model.mesh.boundaries.len() - 1;
-                        let d = self.travel_cotangent(j);
+                        let d =
+                            travel_cotangent(self.travel_weight, &self.ks, &self.shapes, end, j);
                         self.adj.add_pos(end, 1.0, d);
                     }
                     self.adj.finish(&self.model, &self.shapes[j], &mut self.ga);
@@ -498,12 +496,7 @@ impl Nlp for MinimaxProblem {
             }
             if self.travel_weight != 0.0 {
                 let end = model.mesh.boundaries.len() - 1;
-                let x = |i: usize| self.shapes[i].positions[end];
-                let (back, ahead) = (k - self.ks[j - 1], self.ks[j + 1] - k);
-                let (xp, xj, xn) = (x(j - 1), x(j), x(j + 1));
-                let d: [f64; 3] = std::array::from_fn(|c| {
-                    self.travel_weight * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead)
-                });
+                let d = travel_cotangent(self.travel_weight, &self.ks, &self.shapes, end, j);
                 self.adj.add_pos(end, 1.0, d);
             }
             self.adj.finish_hessian(model, shape, ha);

@@ -277,9 +277,7 @@ impl Model {
 
     /// Euler angles `(φ, θ, ψ)` at dimensionless arc length `t`.
     pub fn angles_at(&self, a: &[f64], t: f64) -> [f64; 3] {
-        let b = &self.layout.basis;
-        let f = |field| self.layout.field(a, field).map_or(0.0, |c| b.eval(c, t));
-        [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
+        self.layout.angles_at(a, t)
     }
 
     /// The cross-section's frame at `t` in the case's axes, `R A(φ, θ, ψ)` (row-major; its

@@ -105,4 +105,11 @@ impl Layout {
     pub fn field<'a>(&self, a: &'a [f64], field: Field) -> Option<&'a [f64]> {
         self.offset(field).map(|o| &a[o..o + self.nb()])
     }
+
+    /// Euler angles `(φ, θ, ψ)` of coefficients `a` at dimensionless arc length `t` (zero for a
+    /// field the layout does not have).
+    pub fn angles_at(&self, a: &[f64], t: f64) -> [f64; 3] {
+        let f = |field| self.field(a, field).map_or(0.0, |c| self.basis.eval(c, t));
+        [f(Field::Phi), f(Field::Theta), f(Field::Psi)]
+    }
 }

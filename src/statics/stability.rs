@@ -20,12 +20,13 @@
 //! frame turned back about the tangent so that every clamped frame is unchanged — is a family of
 //! equilibria of equal energy. Its direction is neutral in the continuum, and the Ritz fields
 //! hold it only up to their resolution, so its eigenvalue is rounding of either sign: it is
-//! taken out, and the shape is judged on the rest (see `rotation_symmetry` in this file). Angles measured
-//! from the case's axes with a clamp on their pole do not hold this symmetry (the clamp's rows
-//! on `φ` and `ψ` act as a hidden support), and there nothing is removed.
+//! taken out, and the shape is judged on the rest (see `rotation_symmetry` in this file).
+//! Angles measured from the case's axes with a clamp on their pole do not hold this symmetry
+//! (the clamp's rows on `φ` and `ψ` act as a hidden support), and there nothing is removed.
 
 use crate::optim::second_order::{lagrangian_hessian_and_tangents, null_space};
 use crate::rod::layout::Field;
+use crate::rod::model::Model;
 use crate::statics::problem::StaticProblem;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -69,11 +70,9 @@ pub struct Stability {
     pub resolution: f64,
 }
 
-/// The Gram matrix of the unknowns' perturbations: per field `∫₀¹ eᵢ eⱼ dt` over the model's
-/// quadrature; the identity on base-position unknowns.
-fn metric(p: &StaticProblem) -> DMatrix<f64> {
-    let m = &p.model;
-    let (n, nb) = (m.n(), m.nb());
+/// The basis's Gram matrix `∫₀¹ eᵢ eⱼ dt` over the model's quadrature.
+fn gram(m: &Model) -> DMatrix<f64> {
+    let nb = m.nb();
     let mut g = DMatrix::<f64>::zeros(nb, nb);
     for (q, &w) in m.mesh.weights.iter().enumerate() {
         let e = m.e_at(q);
@@ -83,32 +82,37 @@ fn metric(p: &StaticProblem) -> DMatrix<f64> {
             }
         }
     }
+    g
+}
+
+/// The Gram matrix of the unknowns' perturbations: per field the basis's `g` ([`gram`]); the
+/// identity on base-position unknowns.
+fn metric(p: &StaticProblem, g: &DMatrix<f64>) -> DMatrix<f64> {
+    let m = &p.model;
+    let (n, nb) = (m.n(), m.nb());
     let mut out = DMatrix::<f64>::identity(n, n);
     for f in [Field::Theta, Field::Phi, Field::Psi, Field::Eps] {
         if let Some(o) = m.layout.offset(f) {
-            out.view_mut((o, o), (nb, nb)).copy_from(&g);
+            out.view_mut((o, o), (nb, nb)).copy_from(g);
         }
     }
     out
 }
 
 /// The coefficients of the constant function 1 in the basis (least squares on the Gram
-/// matrix: exact for bases that hold the constant).
-fn constant_coefficients(p: &StaticProblem) -> DVector<f64> {
+/// matrix `g`: exact for bases that hold the constant).
+fn constant_coefficients(p: &StaticProblem, g: &DMatrix<f64>) -> DVector<f64> {
     let m = &p.model;
     let nb = m.nb();
-    let mut g = DMatrix::<f64>::zeros(nb, nb);
     let mut b = DVector::<f64>::zeros(nb);
     for (q, &w) in m.mesh.weights.iter().enumerate() {
         let e = m.e_at(q);
         for i in 0..nb {
             b[i] += w * e[i];
-            for j in 0..nb {
-                g[(i, j)] += w * e[i] * e[j];
-            }
         }
     }
-    g.svd(true, true)
+    g.clone()
+        .svd(true, true)
         .solve(&b, 1e-12)
         .unwrap_or_else(|_| DVector::zeros(nb))
 }
@@ -136,7 +140,8 @@ fn symmetry_axis(p: &StaticProblem, a: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let f = m.frame_at(a, t);
         [f[0][2], f[1][2], f[2][2]]
     };
-    let origin = m.position_at(a, 0.0);
+    let shape = m.evaluate(a);
+    let origin = shape.positions[0];
     let u = tangent(0.0);
     let tol = 1e-7;
     let on_axis = |x: [f64; 3]| {
@@ -150,7 +155,6 @@ fn symmetry_axis(p: &StaticProblem, a: &[f64]) -> Option<([f64; 3], [f64; 3])> {
             .iter()
             .all(|c| c.abs() <= tol)
     };
-    let shape = m.evaluate(a);
     for c in &p.constraints {
         let ok = match c {
             Constraint::Position(k) => on_axis(shape.positions[k.boundary]),
@@ -175,10 +179,10 @@ fn symmetry_axis(p: &StaticProblem, a: &[f64]) -> Option<([f64; 3], [f64; 3])> {
 /// `δθ = u·n`, `δψ = u·m / sin θ − 1`, `δφ = u_z − (u·m) cos θ / sin θ`,
 ///
 /// with `m = (cos φ, sin φ, 0)`, `n = (−sin φ, cos φ, 0)` and `u` in the angles' frame, and
-/// projected on the basis in `L²`. `None` where a node lies on the pole (`sin θ < 1e-6`): there
+/// projected on the basis in `L²` (Gram matrix `g`). `None` where a node lies on the pole (`sin θ < 1e-6`): there
 /// the angles cannot carry the rotation, and the pole's own gauges apply; `None` too for a rod
 /// that lies along the axis, which the rotation does not move.
-fn rotation_symmetry(p: &StaticProblem, a: &[f64]) -> Option<DVector<f64>> {
+fn rotation_symmetry(p: &StaticProblem, a: &[f64], g: &DMatrix<f64>) -> Option<DVector<f64>> {
     let (_, u) = symmetry_axis(p, a)?;
     let m = &p.model;
     let lay = m.layout;
@@ -186,7 +190,6 @@ fn rotation_symmetry(p: &StaticProblem, a: &[f64]) -> Option<DVector<f64>> {
     let os = lay.offset(Field::Psi);
     let u = m.to_angles(u);
     let nb = m.nb();
-    let mut gram = DMatrix::<f64>::zeros(nb, nb);
     let mut rhs = DMatrix::<f64>::zeros(nb, 3);
     let mut size = 0.0;
     for (q, (&t, &w)) in m.mesh.nodes.iter().zip(&m.mesh.weights).enumerate() {
@@ -204,28 +207,26 @@ fn rotation_symmetry(p: &StaticProblem, a: &[f64]) -> Option<DVector<f64>> {
             for (k, dk) in d.iter().enumerate() {
                 rhs[(i, k)] += w * e[i] * dk;
             }
-            for j in 0..nb {
-                gram[(i, j)] += w * e[i] * e[j];
-            }
         }
     }
     // A straight rod turned about its own axis does not move: no direction to remove.
     if size.sqrt() < 1e-8 {
         return None;
     }
-    let x = gram.svd(true, true).solve(&rhs, 1e-12).ok()?;
-    let mut g = DVector::<f64>::zeros(a.len());
-    g.rows_mut(op, nb).copy_from(&x.column(0));
-    g.rows_mut(ot, nb).copy_from(&x.column(1));
+    let x = g.clone().svd(true, true).solve(&rhs, 1e-12).ok()?;
+    let mut dir = DVector::<f64>::zeros(a.len());
+    dir.rows_mut(op, nb).copy_from(&x.column(0));
+    dir.rows_mut(ot, nb).copy_from(&x.column(1));
     if let Some(os) = os {
-        g.rows_mut(os, nb).copy_from(&x.column(2));
+        dir.rows_mut(os, nb).copy_from(&x.column(2));
     }
-    (g.norm() > 0.0).then_some(g)
+    (dir.norm() > 0.0).then_some(dir)
 }
 
 /// Judges the static solution `(a, lambda)` of `p`.
 pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     let (hess, exact, z) = lagrangian_hessian_and_tangents(p, a, lambda, 1e-8);
+    let basis_gram = gram(&p.model);
     let n = a.len();
     let hmax = hess.amax().max(1e-300);
     // Gauge candidates: ψ + const, and φ_i − ψ_i for every basis function (the pole).
@@ -233,7 +234,7 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     let mut pole = Vec::new();
     let lay = p.model.layout;
     if let (Some(op), Some(os)) = (lay.offset(Field::Phi), lay.offset(Field::Psi)) {
-        let c = constant_coefficients(p);
+        let c = constant_coefficients(p, &basis_gram);
         let mut g = DVector::<f64>::zeros(n);
         g.rows_mut(os, c.len()).copy_from(&c);
         psi_shift.push(g);
@@ -258,7 +259,8 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
         // Only where the discrete constraints hold the symmetry too: separate rows on `φ` and
         // `ψ` at a clamp on the pole forbid it (a resolved shape leaves about 1e-5 of the
         // direction outside the tangent space, such a clamp about 0.4).
-        rotation_symmetry(p, a).filter(|g| (g - &z * (z.transpose() * g)).norm() <= 1e-3 * g.norm())
+        rotation_symmetry(p, a, &basis_gram)
+            .filter(|g| (g - &z * (z.transpose() * g)).norm() <= 1e-3 * g.norm())
     };
     // The tangent basis with the gauge span taken out.
     let zg = if z.ncols() == 0 {
@@ -297,7 +299,7 @@ pub fn judge(p: &mut StaticProblem, a: &[f64], lambda: &[f64]) -> Stability {
     }
     let a_red = zg.transpose() * &hess * &zg;
     let a_red = 0.5 * (&a_red + a_red.transpose());
-    let b_red = zg.transpose() * metric(p) * &zg;
+    let b_red = zg.transpose() * metric(p, &basis_gram) * &zg;
     let b_red = 0.5 * (&b_red + b_red.transpose());
     let ev: Vec<f64> = match b_red.clone().cholesky() {
         Some(ch) => {
