@@ -314,9 +314,9 @@ impl Model {
         let x0 = shape.positions[j];
         let mut x = if self.frame.is_some() { [0.0; 3] } else { x0 };
         let t0 = self.mesh.boundaries[j];
-        let (gx, gw) = crate::rod::quadrature::gauss_legendre(8);
+        let (gx, gw) = crate::rod::quadrature::gauss_legendre_8();
         let h = t - t0;
-        for (xi, wi) in gx.iter().zip(&gw) {
+        for (xi, wi) in gx.iter().zip(gw) {
             let u = t0 + 0.5 * h * (xi + 1.0);
             let [ph, th, _] = self.angles_at(a, u);
             let one = 1.0 + self.strain_at(a, u);

@@ -2,6 +2,13 @@
 //! point where a position is needed (constraint points, obstacle samples), so that positions at
 //! those points are exact cumulative sums of panel integrals (eq. 6).
 
+/// The 8-point Gauss–Legendre rule on `[-1, 1]` ([`gauss_legendre`]`(8)`), computed once: the
+/// positions between mesh boundaries integrate with it.
+pub fn gauss_legendre_8() -> &'static (Vec<f64>, Vec<f64>) {
+    static RULE: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
+    RULE.get_or_init(|| gauss_legendre(8))
+}
+
 /// Gauss–Legendre nodes and weights on `[-1, 1]` with `n` points (Newton on `Pₙ`).
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut x = vec![0.0; n];
