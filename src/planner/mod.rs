@@ -958,6 +958,7 @@ impl Planner {
                     StartSummary {
                         start: r.index,
                         path_terms: r.terms,
+                        travel_weight: r.travel_weight,
                         status: v.run.status,
                         sampled_u_max: v.run.sampled_max,
                         u_max: v.verification.u_max,

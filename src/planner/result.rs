@@ -95,6 +95,9 @@ pub struct StartSummary {
     pub start: usize,
     /// Path terms `m` of the start's path.
     pub path_terms: usize,
+    /// Weight of the travel term in the start's objective: the case's `travel_weight`, or 0
+    /// for the last fallback's starts (the paper's objective).
+    pub travel_weight: f64,
     /// Final optimiser status.
     pub status: AlStatus,
     /// Largest sampled energy (case units).

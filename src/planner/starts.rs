@@ -1,7 +1,8 @@
 //! Which starts run: groups of `parallel_starts` starts side by side, first with the case's path
-//! terms and then with each of `fallback_path_terms`, until the best plan so far is executable
-//! (its replay coincides with it, or its replayed equilibria are a plan); and which of the
-//! plans is the plan.
+//! terms, then with each of `fallback_path_terms`, and last (when the objective has a travel
+//! term) with the case's path terms and the paper's objective, without the travel term, until
+//! the best plan so far is executable (its replay coincides with it, or its replayed equilibria
+//! are a plan); and which of the plans is the plan.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
@@ -19,6 +20,8 @@ pub(super) struct StartPlan {
     pub(super) index: usize,
     /// Path terms of its path.
     pub(super) terms: usize,
+    /// Weight of the travel term in its objective.
+    pub(super) travel_weight: f64,
     /// The plan, verified and refined.
     pub(super) plan: Verified,
 }
@@ -60,6 +63,13 @@ impl Planner {
     pub fn with_terms(&self, terms: usize) -> Planner {
         let mut p = self.clone();
         p.settings.path_terms = terms;
+        p
+    }
+
+    /// The planner with the paper's objective: no travel term, the same settings otherwise.
+    fn without_travel(&self) -> Planner {
+        let mut p = self.clone();
+        p.settings.travel_weight = 0.0;
         p
     }
 
@@ -105,13 +115,17 @@ impl Planner {
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let starts = self.settings.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
-        // The case's planner, then one per fallback count, made only when it is reached.
+        // The case's planner, then one per fallback count, then (with a travel term) the
+        // case's without it, each made only when it is reached. A route that must move the end
+        // away and back (two shapes at one pose) is one the travel term argues against.
         let fallbacks = self.settings.fallback_terms(self.base.model.layout.spatial);
-        let attempts = std::iter::once(Cow::Borrowed(self)).chain(
-            fallbacks
-                .into_iter()
-                .map(|t| Cow::Owned(self.with_terms(t))),
-        );
+        let attempts = std::iter::once(Cow::Borrowed(self))
+            .chain(
+                fallbacks
+                    .into_iter()
+                    .map(|t| Cow::Owned(self.with_terms(t))),
+            )
+            .chain((self.settings.travel_weight > 0.0).then(|| Cow::Owned(self.without_travel())));
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();
@@ -137,6 +151,7 @@ impl Planner {
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
                     terms: pl.settings.path_terms,
+                    travel_weight: pl.settings.travel_weight,
                     plan,
                 }));
                 // Checked before the next group, and before the next fallback planner is made.

