@@ -10,6 +10,13 @@ use super::verify::Verification;
 use super::{Planner, settings};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
 
+/// Optimality tolerance of a 3D rod's sharpness stages before the last (feasibility: a tenth
+/// of it); the last stage keeps [`Planner::stage_options`]'. On the generated suite (seeds 1
+/// and 2) the 3D plans' median time fell from 1.15 s to 0.78 s and from 1.30 s to 0.98 s, with
+/// 29 and 25 of 30 plans executable against 29 and 26. (On planar rods the median fell by less
+/// than a tenth, and which local minimum the paper's case reaches changed.)
+const EARLY_STAGE_OPTIMALITY: f64 = 1e-3;
+
 /// What the multiplier-method calls of one start have produced so far.
 #[derive(Clone)]
 pub(super) struct Tally {
@@ -93,6 +100,17 @@ impl Planner {
         let mut z = z0;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
             p.beta = b / u_ref;
+            // On a 3D rod, stages before the sharpest only carry the path to the next one.
+            let al = if self.base.model.layout.spatial && stage + 1 < self.settings.sharpness.len()
+            {
+                AlOptions {
+                    optimality_tol: EARLY_STAGE_OPTIMALITY,
+                    feasibility_tol: 0.1 * EARLY_STAGE_OPTIMALITY,
+                    ..al
+                }
+            } else {
+                al
+            };
             let out = {
                 let sink = &mut *sink;
                 let ks = p.ks.clone();
