@@ -140,7 +140,9 @@ pub struct PlanResult {
     pub u_max_straight: f64,
     /// Smallest obstacle clearance on the verification grid, optimal path (case units).
     pub min_clearance: Option<f64>,
-    /// Smallest obstacle clearance of the straight-line path (case units).
+    /// Smallest obstacle clearance of the straight-line path (case units): on the verification
+    /// grid, and between its values only where the path could pass through an obstacle
+    /// unseen (the depth of a penetration the grid already sees is not refined there).
     pub min_clearance_straight: Option<f64>,
     /// Largest violation of the optimiser's sampled constraints (dimensionless).
     pub violation: f64,

@@ -110,11 +110,15 @@ fn record(fine: &Model, gaps: &[Vec<f64>], k: f64, worst: &mut [ObstacleClearanc
 }
 
 /// The smallest chord bound `(g(p) + g(q) − |q − p|)/2` of any point and obstacle between two
-/// shapes (case units).
-fn chord_bound(a: &ShapeGaps, b: &ShapeGaps) -> f64 {
+/// shapes (case units); with `skip_inside`, leaving out points inside the obstacle in both
+/// shapes (their collision is on the grid already; bisecting only measures its depth).
+fn chord_bound(a: &ShapeGaps, b: &ShapeGaps, skip_inside: bool) -> f64 {
     let mut lo = f64::INFINITY;
     for (ga, gb) in a.1.iter().zip(&b.1) {
         for j in 0..a.0.len() {
+            if skip_inside && ga[j] < 0.0 && gb[j] < 0.0 {
+                continue;
+            }
             let (p, q) = (a.0[j], b.0[j]);
             let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
             lo = lo.min(0.5 * (ga[j] + gb[j] - d));
@@ -123,8 +127,9 @@ fn chord_bound(a: &ShapeGaps, b: &ShapeGaps) -> f64 {
     lo
 }
 
-/// Bisects `(k0, k1)` while the chord bound between its ends is negative, up to `depth` times,
-/// recording every evaluated shape's clearances in `worst`.
+/// Bisects `(k0, k1)` while the chord bound between its ends is negative (see
+/// [`chord_bound`] for `skip_inside`), up to `depth` times, recording every evaluated shape's
+/// clearances in `worst`.
 #[allow(clippy::too_many_arguments)]
 fn between(
     fine: &Model,
@@ -134,9 +139,10 @@ fn between(
     lo: (f64, &ShapeGaps),
     hi: (f64, &ShapeGaps),
     depth: usize,
+    skip_inside: bool,
     worst: &mut [ObstacleClearance],
 ) {
-    if depth == 0 || chord_bound(lo.1, hi.1) >= 0.0 {
+    if depth == 0 || chord_bound(lo.1, hi.1, skip_inside) >= 0.0 {
         return;
     }
     let k = 0.5 * (lo.0 + hi.0);
@@ -144,8 +150,28 @@ fn between(
     path.shape_at(z, k, &mut a);
     let mid = gaps_at(fine, obstacles, &fine.evaluate(&a).positions);
     record(fine, &mid.1, k, worst);
-    between(fine, path, z, obstacles, lo, (k, &mid), depth - 1, worst);
-    between(fine, path, z, obstacles, (k, &mid), hi, depth - 1, worst);
+    between(
+        fine,
+        path,
+        z,
+        obstacles,
+        lo,
+        (k, &mid),
+        depth - 1,
+        skip_inside,
+        worst,
+    );
+    between(
+        fine,
+        path,
+        z,
+        obstacles,
+        (k, &mid),
+        hi,
+        depth - 1,
+        skip_inside,
+        worst,
+    );
 }
 
 /// Each obstacle's worst clearance before any shape is seen (infinite).
@@ -249,6 +275,54 @@ pub fn verify_with(
     objective: Objective,
     self_contact: bool,
 ) -> Verification {
+    verify_grid(
+        fine,
+        path,
+        z,
+        k_samples,
+        obstacles,
+        objective,
+        self_contact,
+        false,
+    )
+}
+
+/// [`verify_with`] for a report (the straight-line path's): where a point lies inside an
+/// obstacle at two consecutive grid values, the collision is reported on the grid, and the
+/// interval between them is not bisected to measure its depth there.
+pub(crate) fn verify_for_report(
+    fine: &Model,
+    path: &DeformationPath,
+    z: &[f64],
+    k_samples: usize,
+    obstacles: &[Arc<Obstacle>],
+    objective: Objective,
+    self_contact: bool,
+) -> Verification {
+    verify_grid(
+        fine,
+        path,
+        z,
+        k_samples,
+        obstacles,
+        objective,
+        self_contact,
+        true,
+    )
+}
+
+/// [`verify_with`]; with `skip_inside`, [`verify_for_report`].
+#[allow(clippy::too_many_arguments)]
+fn verify_grid(
+    fine: &Model,
+    path: &DeformationPath,
+    z: &[f64],
+    k_samples: usize,
+    obstacles: &[Arc<Obstacle>],
+    objective: Objective,
+    self_contact: bool,
+    skip_inside: bool,
+) -> Verification {
     let (chord_pts, pairs) = self_contact_chords(fine, self_contact);
     let mut worst_self: Option<(f64, f64)> = None;
     let unit = fine.rod.energy_unit();
@@ -292,6 +366,7 @@ pub fn verify_with(
             (k0, &grid[w]),
             (k1, &grid[w + 1]),
             6,
+            skip_inside,
             &mut worst,
         );
     }
