@@ -807,7 +807,7 @@ impl Planner {
         let nv = path.n_vars();
         let fine = fine_model(model, self.settings.verify_s_samples, 4);
         // Reported only: where its shapes lie inside an obstacle, at grid values.
-        let straight = verify::verify_for_report(
+        let straight = verify::verify_grid(
             &fine,
             &path,
             &vec![0.0; nv],
@@ -815,6 +815,7 @@ impl Planner {
             &self.obstacles,
             self.base.objective,
             self.has_self_contact(),
+            true,
         );
         {
             let mut a = vec![0.0; path.n()];

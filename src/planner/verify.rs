@@ -287,33 +287,11 @@ pub fn verify_with(
     )
 }
 
-/// [`verify_with`] for a report (the straight-line path's): where a point lies inside an
-/// obstacle at two consecutive grid values, the collision is reported on the grid, and the
-/// interval between them is not bisected to measure its depth there.
-pub(crate) fn verify_for_report(
-    fine: &Model,
-    path: &DeformationPath,
-    z: &[f64],
-    k_samples: usize,
-    obstacles: &[Arc<Obstacle>],
-    objective: Objective,
-    self_contact: bool,
-) -> Verification {
-    verify_grid(
-        fine,
-        path,
-        z,
-        k_samples,
-        obstacles,
-        objective,
-        self_contact,
-        true,
-    )
-}
-
-/// [`verify_with`]; with `skip_inside`, [`verify_for_report`].
+/// [`verify_with`]; with `skip_inside`, for a report (the straight-line path's): where a point
+/// lies inside an obstacle at two consecutive grid values, the collision is reported on the
+/// grid, and the interval between them is not bisected to measure its depth there.
 #[allow(clippy::too_many_arguments)]
-fn verify_grid(
+pub(crate) fn verify_grid(
     fine: &Model,
     path: &DeformationPath,
     z: &[f64],
