@@ -807,16 +807,7 @@ impl Planner {
         let nv = path.n_vars();
         let fine = fine_model(model, self.settings.verify_s_samples, 4);
         // Reported only: where its shapes lie inside an obstacle, at grid values.
-        let straight = verify::verify_grid(
-            &fine,
-            &path,
-            &vec![0.0; nv],
-            self.settings.verify_k_samples,
-            &self.obstacles,
-            self.base.objective,
-            self.has_self_contact(),
-            true,
-        );
+        let straight = self.verify_on(&fine, &path, &vec![0.0; nv], true);
         {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();

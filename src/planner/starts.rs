@@ -7,7 +7,7 @@
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
 use super::start::Verified;
-use super::verify::{Verification, verify_with};
+use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
 use std::borrow::Cow;
@@ -73,14 +73,16 @@ impl Planner {
         p
     }
 
-    /// The path `z` of `path` on the verification grid of the quadrature `fine`.
+    /// The path `z` of `path` on the verification grid of the quadrature `fine`; with
+    /// `skip_inside`, for a report only ([`super::verify::verify_grid`]).
     pub(super) fn verify_on(
         &self,
         fine: &Model,
         path: &DeformationPath,
         z: &[f64],
+        skip_inside: bool,
     ) -> Verification {
-        verify_with(
+        verify_grid(
             fine,
             path,
             z,
@@ -88,6 +90,7 @@ impl Planner {
             &self.obstacles,
             self.base.objective,
             self.has_self_contact(),
+            skip_inside,
         )
     }
 
@@ -129,7 +132,7 @@ impl Planner {
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();
-            let check = |z: &[f64]| self.verify_on(fine, &path, z);
+            let check = |z: &[f64]| self.verify_on(fine, &path, z, false);
             // Start s: the straight-line path plus a perturbation of seed `seed + s`, 0.01 rad
             // for the first, `start_spread` for the others.
             let zs: Vec<(usize, Vec<f64>)> = (0..starts)
