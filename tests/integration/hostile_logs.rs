@@ -141,12 +141,40 @@ fn fuzz(name: &str, base: &[u8], budget: Duration) {
         64,
         budget,
         prop::collection::vec(edit(), 1..6),
-        |edits| check(base, messages, &apply(base, &edits)),
+        |edits| {
+            let damaged = apply(base, &edits);
+            let result = check(base, messages, &damaged);
+            if result.is_err() {
+                keep_failure(name, base, &damaged);
+            }
+            result
+        },
     );
     eprintln!(
         "{name}: {cases} damaged logs in {:.1} s",
         start.elapsed().as_secs_f64()
     );
+}
+
+/// Writes a failing damaged log and its base (which holds run-dependent log times and
+/// timings, so a batch number alone does not reproduce it) under `target/test-logs/hostile/`.
+/// Proptest shrinks a failure case by case, so the file left is the smallest failing one.
+fn keep_failure(name: &str, base: &[u8], damaged: &[u8]) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-logs/hostile");
+    let stem = name.replace(' ', "-");
+    let base_path = dir.join(format!("{stem}-base.mcap"));
+    let failing = dir.join(format!("{stem}-failing.mcap"));
+    static TOLD: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    if std::fs::write(&base_path, base).is_ok()
+        && std::fs::write(&failing, damaged).is_ok()
+        && !TOLD.swap(true, std::sync::atomic::Ordering::Relaxed)
+    {
+        eprintln!(
+            "{name}: failing log kept as {} (its base: {})",
+            failing.display(),
+            base_path.display()
+        );
+    }
 }
 
 fn budget() -> Duration {
@@ -180,4 +208,66 @@ fn every_single_byte_flip_of_a_log_is_found() {
             "flip at byte {i} recovered as complete"
         );
     }
+}
+
+/// Offsets of the top-level records of a finished log with `opcode` (walked by their length
+/// fields from the start magic to the data end).
+fn records_with_opcode(log: &[u8], opcode: u8) -> Vec<usize> {
+    let mut at = 8;
+    let mut found = Vec::new();
+    while at + 9 <= log.len() {
+        let op = log[at];
+        if op == 0x0F {
+            break; // data end
+        }
+        if op == opcode {
+            found.push(at);
+        }
+        let len = u64::from_le_bytes(log[at + 1..at + 9].try_into().unwrap());
+        at += 9 + len as usize;
+    }
+    found
+}
+
+/// A message index between chunks (it starts with a real channel id) whose opcode is changed to
+/// that of a message reads as a message of that channel: the reader must stop there, not count
+/// it, and every reader must call the log damaged.
+#[test]
+fn a_message_index_turned_into_a_message_is_damage() {
+    let base = log_of("shape", "planning_cases/pinned_buckling_080.json");
+    let messages = inspect(&base).unwrap().messages;
+    let indexes = records_with_opcode(&base, 0x07);
+    assert!(!indexes.is_empty(), "the log has message indexes");
+    for at in indexes {
+        let mut b = base.clone();
+        b[at] = 0x05;
+        let ins = inspect(&b).unwrap();
+        assert!(ins.messages <= messages, "{} > {messages}", ins.messages);
+        assert!(ins.stopped_at.is_some() && ins.damage.is_some());
+        let r = recover(&b, std::io::Cursor::new(Vec::new())).unwrap();
+        assert!(r.truncated && r.messages <= messages);
+    }
+}
+
+/// A footer whose CRC became 0 ("not computed") is checked by where it points: a summary
+/// offset start moved outside the file, or the summary start moved off its section, is damage.
+#[test]
+fn a_footer_without_its_crc_is_checked_by_its_offsets() {
+    let base = log_of("shape", "planning_cases/pinned_buckling_080.json");
+    let crc_at = base.len() - 8 - 4;
+    let offsets_at = crc_at - 8;
+    let start_at = offsets_at - 8;
+    for (at, value) in [(offsets_at, 1u64 << 63), (offsets_at, 9), (start_at, 9)] {
+        let mut b = base.clone();
+        b[crc_at..crc_at + 4].fill(0);
+        b[at..at + 8].copy_from_slice(&value.to_le_bytes());
+        assert!(check_finished(&b).is_err(), "field at {at} set to {value}");
+        assert!(inspect(&b).unwrap().damage.is_some());
+        let r = recover(&b, std::io::Cursor::new(Vec::new())).unwrap();
+        assert!(r.truncated);
+    }
+    // The CRC alone set to 0 leaves a log with the same contents: still a finished log.
+    let mut b = base.clone();
+    b[crc_at..crc_at + 4].fill(0);
+    assert_eq!(check_finished(&b), Ok(()));
 }

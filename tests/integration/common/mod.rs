@@ -188,7 +188,8 @@ pub fn fuzz_seconds() -> f64 {
 
 /// Runs batches of `cases` proptest cases of `test` on `strategy`, each batch from its own fixed
 /// seed (`salt`, batch number), until `budget` has passed (at least one batch); panics naming
-/// the batch that fails, so that it can be rerun. Returns the cases run.
+/// the batch that fails, so that it can be rerun: `DLO_FUZZ_BATCH=N` runs batch N alone.
+/// Returns the cases run.
 pub fn run_batches<S: proptest::strategy::Strategy>(
     name: &str,
     salt: u8,
@@ -199,8 +200,12 @@ pub fn run_batches<S: proptest::strategy::Strategy>(
 ) -> u64 {
     use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
     let start = std::time::Instant::now();
-    let mut batch = 0u64;
-    while batch == 0 || start.elapsed() < budget {
+    let only: Option<u64> = std::env::var("DLO_FUZZ_BATCH")
+        .ok()
+        .and_then(|s| s.parse().ok());
+    let mut batch = only.unwrap_or(0);
+    let mut run = 0u64;
+    while run == 0 || (only.is_none() && start.elapsed() < budget) {
         let mut seed = [salt; 32];
         seed[..8].copy_from_slice(&batch.to_le_bytes());
         let config = Config {
@@ -214,6 +219,7 @@ pub fn run_batches<S: proptest::strategy::Strategy>(
             panic!("{name}, batch {batch}: {e}");
         }
         batch += 1;
+        run += 1;
     }
-    batch * u64::from(cases)
+    run * u64::from(cases)
 }
