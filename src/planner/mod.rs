@@ -836,17 +836,18 @@ impl Planner {
         self.poll(observer);
         let tol = self.collision_tolerance();
         // The best plan so far is replayed (its shapes kept, to be logged if it is chosen)
-        // after each group of starts; the starts stop at the first executable one.
+        // after each group of starts; the starts stop at the first executable one, or as soon
+        // as a replay leaves the start shape at k = 0, which no path can change.
         let mut judged: Vec<(usize, Judged)> = Vec::new();
         let mut judge = |runs: &[StartPlan], observer: &mut dyn PlanObserver| -> bool {
             let best = self.best_of(runs);
             if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
-                return j.executable;
+                return j.executable || !j.replay.start_held();
             }
             let j = self.judge(&runs[best], &fine, observer);
-            let executable = j.executable;
+            let stop = j.executable || !j.replay.start_held();
             judged.push((best, j));
-            executable
+            stop
         };
         let runs = self.run_starts(&fine, observer, &mut judge);
         // The plan: the executable one if any, else the best by class and U_max.
@@ -874,7 +875,11 @@ impl Planner {
         let straight_path = self.path();
         let straight_z = vec![0.0; straight_path.n_vars()];
         let mut along_straight = false;
-        if !judged.executable && self.settings.equilibrium_plans && !self.stopped() {
+        if !judged.executable
+            && judged.replay.start_held()
+            && self.settings.equilibrium_plans
+            && !self.stopped()
+        {
             let mut s = self.judge_path(&straight_path, &straight_z, false, &fine, observer);
             if let Some(e) = s.equilibrium_plan.as_mut() {
                 e.trajectory = "straight_path";

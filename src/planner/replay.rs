@@ -86,6 +86,14 @@ pub struct Replay {
 }
 
 impl Replay {
+    /// Whether the replay stays on the start shape at `k = 0` (within the tolerance), as it
+    /// does wherever the start shape is an equilibrium of its end pose. Every path starts on the
+    /// start shape, so where the replay leaves it there no path can be executed from it by the
+    /// controlled end alone. True for a replay that did not run.
+    pub fn start_held(&self) -> bool {
+        self.steps.is_empty() || self.start_deviation_over_l <= self.tolerance
+    }
+
     /// The replay of a run stopped before it: no step, no verdict (`coincide` false).
     pub fn not_run(tolerance: f64) -> Replay {
         Replay {

@@ -211,7 +211,14 @@ pub(crate) fn run_plan(
                     format!(", snap-through at k = {}", snap_list(&result.replay.snaps))
                 },
                 equilibria_not_a_plan(&result),
-                TRY_DEPARTURE
+                if result.replay.start_held() {
+                    TRY_DEPARTURE.to_string()
+                } else {
+                    format!(
+                        "the start shape is not held by its end pose (not a stable equilibrium there): the replay leaves it by {:.3} L at k = 0, so no path from it can be executed by the controlled end; start from the pose alone (plan.start without `shape`) or from a shape the pose holds",
+                        result.replay.start_deviation_over_l
+                    )
+                }
             );
             ExitCode::from(EXIT_NOT_COINCIDENT)
         }
