@@ -76,7 +76,7 @@ impl SettingsError {
         } else {
             Err(SettingsError::new(
                 field,
-                format!("must be finite, got {x}"),
+                format!("must be finite, got {}", Num(x)),
             ))
         }
     }
@@ -88,8 +88,24 @@ impl SettingsError {
         } else {
             Err(SettingsError::new(
                 field,
-                format!("must be positive, got {x}"),
+                format!("must be positive, got {}", Num(x)),
             ))
+        }
+    }
+}
+
+/// A number as an error message writes it: plainly, or in exponent notation where the plain
+/// form would be long (Rust writes 1e300 with 301 digits).
+#[derive(Clone, Copy, Debug)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
         }
     }
 }

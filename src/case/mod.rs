@@ -444,7 +444,10 @@ impl V<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err(field, format!("must be finite, got {v}")))
+            Err(self.err(
+                field,
+                format!("must be finite, got {}", crate::error::Num(v)),
+            ))
         }
     }
     pub(crate) fn positive(&self, field: &str, v: f64) -> Result<f64, Error> {
@@ -452,7 +455,10 @@ impl V<'_> {
         if v > 0.0 {
             Ok(v)
         } else {
-            Err(self.err(field, format!("must be positive, got {v}")))
+            Err(self.err(
+                field,
+                format!("must be positive, got {}", crate::error::Num(v)),
+            ))
         }
     }
     fn profile_positive(&self, field: &str, p: &Profile) -> Result<(), Error> {
@@ -511,7 +517,10 @@ fn build(file: CaseFile, path: &Path) -> Result<Case, Error> {
     let radius = r.radius.unwrap_or(l / 1000.0);
     v.finite("rod.radius", radius)?;
     if radius < 0.0 || radius >= 0.5 * l {
-        return Err(v.err("rod.radius", format!("must be in [0, L/2), got {radius}")));
+        return Err(v.err(
+            "rod.radius",
+            format!("must be in [0, L/2), got {}", crate::error::Num(radius)),
+        ));
     }
     let d = file.discretisation;
     crate::rod::model::check_sizes(d.basis_pairs, d.panels, d.gauss_points, d.samples)

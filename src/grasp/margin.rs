@@ -10,7 +10,7 @@
 //! solved on that interpolation (exact where the forces are linear in `f`).
 
 use super::fingers::{ContactForce, Finger, contact_forces, fingers, friction_ratio};
-use crate::error::SettingsError;
+use crate::error::{Num, SettingsError};
 use crate::statics::builder::{BuildError, StaticProblemBuilder};
 use crate::statics::problem::StaticProblem;
 use crate::statics::{
@@ -118,7 +118,7 @@ impl GraspSettings {
             if !(s.is_finite() && *s > 0.0 && *s < l) {
                 return Err(err(
                     &format!("points[{i}]"),
-                    format!("must be inside (0, {l}), got {s}"),
+                    format!("must be inside (0, {}), got {}", Num(l), Num(*s)),
                 ));
             }
         }
@@ -197,7 +197,7 @@ impl GraspSettings {
             if !(m.is_finite() && *m >= 0.0) {
                 return Err(err(
                     &format!("mu[{i}]"),
-                    format!("must be finite and ≥ 0, got {m}"),
+                    format!("must be finite and ≥ 0, got {}", Num(*m)),
                 ));
             }
         }
@@ -349,7 +349,10 @@ impl Grasp {
         let has_pinch = fingers.iter().any(|f| f.pinch_with.is_some());
         let preload = match (spec.preload, has_pinch) {
             (Some(p), _) if !(p.is_finite() && p >= 0.0) => {
-                return Err(err("preload", format!("must be finite and ≥ 0, got {p}")));
+                return Err(err(
+                    "preload",
+                    format!("must be finite and ≥ 0, got {}", Num(p)),
+                ));
             }
             (Some(p), _) => p,
             (None, true) => {
@@ -381,7 +384,10 @@ impl Grasp {
         let n0 = initial_forces.iter().map(|c| c.normal).fold(0.0, f64::max);
         let f_max = spec.f_max.unwrap_or(5.0 * n0.max(preload));
         if !(f_max.is_finite() && f_max > 0.0) {
-            return Err(err("f_max", format!("must be positive, got {f_max}")));
+            return Err(err(
+                "f_max",
+                format!("must be positive, got {}", Num(f_max)),
+            ));
         }
         // The search bisects [0, f_max]: a cap many decades above the rod's force scale leaves
         // the bisection at that scale's resolution and reports a margin there.
@@ -391,7 +397,8 @@ impl Grasp {
             return Err(err(
                 "f_max",
                 format!(
-                    "{f_max} is more than 10⁶ times the rod's force scale (Rf/L² = {fu:.3e}, the largest initial contact force {n0:.3e}, the preload {preload:.3e}): at most {f_cap:.3e}"
+                    "{} is more than 10⁶ times the rod's force scale (Rf/L² = {fu:.3e}, the largest initial contact force {n0:.3e}, the preload {preload:.3e}): at most {f_cap:.3e}",
+                    Num(f_max)
                 ),
             ));
         }

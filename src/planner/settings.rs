@@ -140,7 +140,7 @@ impl Default for PlanSettings {
     }
 }
 
-use crate::error::SettingsError;
+use crate::error::{Num, SettingsError};
 
 /// The error for `field`.
 fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
@@ -212,7 +212,11 @@ impl PlanSettings {
         if !(0.0..=0.25 * l).contains(&finite("safety_margin", safety)?) {
             return Err(bad(
                 "safety_margin",
-                format!("must be in [0, L/4] = [0, {}], got {safety}", 0.25 * l),
+                format!(
+                    "must be in [0, L/4] = [0, {}], got {}",
+                    Num(0.25 * l),
+                    Num(safety)
+                ),
             ));
         }
         if finite("mean_weight", self.mean_weight)? < 0.0 {
@@ -233,7 +237,10 @@ impl PlanSettings {
         if !(0.0..1.0).contains(&stop) {
             return Err(bad(
                 "equilibrium_stop",
-                format!("must be in [0, 1) (a fraction of coincide_tolerance), got {stop}"),
+                format!(
+                    "must be in [0, 1) (a fraction of coincide_tolerance), got {}",
+                    Num(stop)
+                ),
             ));
         }
         if self.sharpness.is_empty() {
@@ -259,7 +266,11 @@ impl PlanSettings {
                 {
                     return Err(bad(
                         format!("workspace.min[{i}]"),
-                        format!("must not exceed workspace.max[{i}] ({hi}), got {lo}"),
+                        format!(
+                            "must not exceed workspace.max[{i}] ({}), got {}",
+                            Num(hi),
+                            Num(lo)
+                        ),
                     ));
                 }
             }

@@ -72,7 +72,10 @@ pub fn speed_limits(
         if !(x > 0.0 && (inf_ok || x.is_finite())) {
             return Err(SettingsError::new(
                 field,
-                format!("must be a positive finite number, got {x}"),
+                format!(
+                    "must be a positive finite number, got {}",
+                    crate::error::Num(x)
+                ),
             ));
         }
     }
@@ -83,7 +86,10 @@ pub fn speed_limits(
 /// component is not finite or the norm is not 1 to 1e-6.
 pub fn rotation_of_unit_quaternion(q: [f64; 4]) -> Result<[[f64; 3]; 3], String> {
     if let Some(i) = q.iter().position(|c| !c.is_finite()) {
-        return Err(format!("component {i} must be finite, got {}", q[i]));
+        return Err(format!(
+            "component {i} must be finite, got {}",
+            crate::error::Num(q[i])
+        ));
     }
     let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
     if (n - 1.0).abs() > 1e-6 {

@@ -269,7 +269,10 @@ impl StaticProblemBuilder {
             message,
         };
         if !(l.is_finite() && l > 0.0) {
-            return Err(err("rod", format!("length must be positive, got {l}")));
+            return Err(err(
+                "rod",
+                format!("length must be positive, got {}", crate::error::Num(l)),
+            ));
         }
         if self.samples == 0 {
             return Err(err("samples", "must be at least 1".into()));
@@ -284,7 +287,10 @@ impl StaticProblemBuilder {
         };
         let finite = |item: &str, what: &str, v: &[f64]| -> Result<(), BuildError> {
             match v.iter().find(|x| !x.is_finite()) {
-                Some(x) => Err(err(item, format!("{what} must be finite, got {x}"))),
+                Some(x) => Err(err(
+                    item,
+                    format!("{what} must be finite, got {}", crate::error::Num(*x)),
+                )),
                 None => Ok(()),
             }
         };
@@ -398,7 +404,10 @@ impl StaticProblemBuilder {
             if !(margin.is_finite() && *margin >= 0.0) {
                 return Err(err(
                     &format!("obstacle {i}"),
-                    format!("margin must be finite and non-negative, got {margin}"),
+                    format!(
+                        "margin must be finite and non-negative, got {}",
+                        crate::error::Num(*margin)
+                    ),
                 ));
             }
         }

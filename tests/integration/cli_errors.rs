@@ -772,6 +772,9 @@ fn hostile_inputs_and_outputs_fail_cleanly() {
             "{name}: {err}"
         );
         assert!(out.is_empty());
+        if name == "huge_cap" {
+            assert!(err.contains("1e300 is more than"), "{err}");
+        }
     }
     let p = with_grasp(
         "huge_direction",
@@ -1126,4 +1129,61 @@ fn limits_warnings_and_blocked_poses_are_reported_before_work() {
     assert_eq!(report["verdict"], "unreachable", "{out}");
     assert_eq!(report["end"], "goal", "{out}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Extreme numbers in an error are written in exponent notation: the message stays short
+/// (Rust writes 1e300 plainly with 301 digits).
+#[test]
+fn extreme_numbers_in_errors_are_written_short() {
+    let dir = std::env::temp_dir().join(format!("dlo-cli-extreme-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/planning_cases/plan_paper_planar.json"
+    ))
+    .unwrap();
+    type Edit<'a> = &'a dyn Fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &str, &str); 4] = [
+        (
+            "margin",
+            &|v| v["plan"]["safety_margin"] = 1e300.into(),
+            "plan.safety_margin",
+            "got 1e300",
+        ),
+        (
+            "radius",
+            &|v| v["rod"]["radius"] = (-1e-300).into(),
+            "rod.radius",
+            "got -1e-300",
+        ),
+        (
+            "length",
+            &|v| v["rod"]["length"] = (-1e200).into(),
+            "rod.length",
+            "got -1e200",
+        ),
+        (
+            "stop",
+            &|v| v["plan"]["equilibrium_stop"] = 1e30.into(),
+            "plan.equilibrium_stop",
+            "got 1e30",
+        ),
+    ];
+    for (name, edit, field, value) in cases {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        edit(&mut v);
+        let p = dir.join(format!("{name}.json"));
+        std::fs::write(&p, v.to_string()).unwrap();
+        let logs = dir.join("logs");
+        let (code, out, err) = run(&[
+            "plan",
+            p.to_str().unwrap(),
+            "--log-dir",
+            logs.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(out.is_empty());
+        assert!(err.contains(field) && err.contains(value), "{name}: {err}");
+        assert!(err.len() < 300, "{name}: {} characters: {err}", err.len());
+    }
 }
