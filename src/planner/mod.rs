@@ -129,6 +129,9 @@ pub struct Planner {
     pub linear_rows: Vec<Vec<f64>>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,
+    /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
+    /// the case's own ([`PlanSettings::fallback_evaluations`]).
+    budget: Option<usize>,
 }
 
 /// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
@@ -622,6 +625,7 @@ impl Planner {
             goal,
             linear_rows,
             stop: Arc::new(AtomicBool::new(false)),
+            budget: None,
         })
     }
 

@@ -99,6 +99,10 @@ impl Planner {
         let al = self.stage_options();
         let mut z = z0;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
+            if self.over_budget(&tally) {
+                tally.status = AlStatus::IterationLimit;
+                break;
+            }
             p.beta = b / u_ref;
             // On a 3D rod, stages before the sharpest only carry the path to the next one.
             let al = if self.base.model.layout.spatial && stage + 1 < self.settings.sharpness.len()
@@ -181,6 +185,13 @@ impl Planner {
     }
 }
 
+impl Planner {
+    /// Whether a start has used up its evaluation budget (see [`Planner::budget`]).
+    pub(super) fn over_budget(&self, tally: &Tally) -> bool {
+        self.budget.is_some_and(|b| tally.evaluations >= b)
+    }
+}
+
 /// One start's plan after its verification and sample refinement.
 #[derive(Clone)]
 pub(super) struct Verified {
@@ -221,7 +232,8 @@ impl Planner {
         for _ in 0..self.settings.sample_refinements {
             let tunnels = !ver.collision_free(tol);
             let peak = missed_peak(&chosen, &ver);
-            if (!tunnels && !peak) || self.stopped() {
+            let spent = self.budget.is_some_and(|b| chosen.evaluations >= b);
+            if (!tunnels && !peak) || self.stopped() || spent {
                 break;
             }
             let worst_k: Vec<f64> = ver

@@ -121,14 +121,15 @@ impl Planner {
         // The case's planner, then one per fallback count, then (with a travel term) the
         // case's without it, each made only when it is reached. A route that must move the end
         // away and back (two shapes at one pose) is one the travel term argues against.
+        // Each attempt after the first has an evaluation budget.
         let fallbacks = self.settings.fallback_terms(self.base.model.layout.spatial);
+        let budget = |mut p: Planner| {
+            p.budget = Some(self.settings.fallback_evaluations);
+            Cow::Owned(p)
+        };
         let attempts = std::iter::once(Cow::Borrowed(self))
-            .chain(
-                fallbacks
-                    .into_iter()
-                    .map(|t| Cow::Owned(self.with_terms(t))),
-            )
-            .chain((self.settings.travel_weight > 0.0).then(|| Cow::Owned(self.without_travel())));
+            .chain(fallbacks.into_iter().map(|t| budget(self.with_terms(t))))
+            .chain((self.settings.travel_weight > 0.0).then(|| budget(self.without_travel())));
         'attempts: for (attempt, pl) in attempts.enumerate() {
             let path = pl.path();
             let nv = path.n_vars();

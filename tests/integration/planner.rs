@@ -35,6 +35,40 @@ fn paper_with(fields: serde_json::Value) -> dlo_planner::planner::PlanResult {
     Planner::from_case(&c).unwrap().run(&mut Silent)
 }
 
+/// The attempts after the case's own have an evaluation budget: on the paper's case with its
+/// three path terms (whose first start does not coincide) and no equilibrium plans, the
+/// six-term fallback stops its sharpness stages once it has used `fallback_evaluations` (checked
+/// between stages, so it may exceed it by one stage), says `iteration_limit`, and its plan is
+/// still verified and reported; without the budget the same fallback runs to convergence.
+#[test]
+fn fallback_attempts_stop_at_their_evaluation_budget() {
+    let fields = |budget: usize| {
+        serde_json::json!({
+            "path_terms": 3, "safety_margin": 0.01, "starts": 1, "fallback_path_terms": [6],
+            "equilibrium_plans": false, "fallback_evaluations": budget
+        })
+    };
+    let limited = paper_with(fields(100));
+    let free = paper_with(fields(100_000_000));
+    assert_eq!(limited.starts.len(), 2);
+    let (first, fallback) = (&limited.starts[0], &limited.starts[1]);
+    assert_eq!(first.path_terms, 3);
+    assert_eq!(fallback.path_terms, 6);
+    assert_eq!(
+        fallback.status,
+        dlo_planner::optim::AlStatus::IterationLimit
+    );
+    assert!(fallback.u_max.is_finite());
+    // The first attempt is the same with either budget; the unlimited fallback converges and
+    // uses more evaluations than the budget allowed.
+    assert_eq!(free.starts[0].evaluations, first.evaluations);
+    assert_eq!(
+        free.starts[1].status,
+        dlo_planner::optim::AlStatus::Converged
+    );
+    assert!(free.starts[1].evaluations > 4 * fallback.evaluations);
+}
+
 /// Equilibrium tracking's strength matters away from the shipped poses: one of the 24 random
 /// start and goal poses of the README's study (the shipped case otherwise, two starts) holds
 /// U_max = its goal shape's energy, so the minimax objective leaves the interior free and tracking
