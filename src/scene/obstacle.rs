@@ -357,18 +357,23 @@ fn spans_volume(points: &[[f64; 3]]) -> bool {
 mod tests {
     use super::*;
 
+    /// Numbers uniform in [−1, 1) from the xorshift* generator seeded with `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            2.0 * ((s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64) - 1.0
+        }
+    }
+
     /// The inlined box projection is parry's, to the bit: points inside, outside, on faces,
     /// edges and corners, at the centre, with zero and negative-zero coordinates and with ties
     /// between faces.
     #[test]
     fn cuboid_projection_is_parrys_to_the_bit() {
-        let mut s = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            2.0 * ((s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64) - 1.0
-        };
+        let mut next = uniform(0x2545_F491_4F6C_DD1D);
         let specials = [0.0, -0.0, 0.2, -0.2, 0.5, -0.5, 0.1, -0.1, 1e-300, 0.7];
         for he in [[0.2, 0.5, 0.5], [0.3, 0.3, 0.3], [1e-3, 2.0, 0.7]] {
             let cub = Cuboid::new(Vector::new(he[0], he[1], he[2]));
@@ -396,18 +401,13 @@ mod tests {
             }
         }
     }
+
     /// The inlined capsule projection is parry's, to the bit: points inside and outside, beyond
     /// either end cap, on the axis (left to parry) and at the end points, for capsules along an
     /// axis, slanted and degenerate (a ball).
     #[test]
     fn capsule_projection_is_parrys_to_the_bit() {
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            2.0 * ((s.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64) - 1.0
-        };
+        let mut next = uniform(0x9E37_79B9_7F4A_7C15);
         let capsules = [
             ([0.0, -0.3, 0.0], [0.0, 0.3, 0.0], 0.1),
             ([-0.2, 0.1, 0.3], [0.4, -0.2, -0.1], 0.05),

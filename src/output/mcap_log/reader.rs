@@ -24,6 +24,14 @@ pub fn check_magic(bytes: &[u8]) -> Result<(), LogError> {
     }
 }
 
+/// Answers a reader's request for `need` more bytes from `bytes` at `*at` (fewer at the end).
+fn feed(reader: &mut mcap::sans_io::LinearReader, bytes: &[u8], at: &mut usize, need: usize) {
+    let n = need.min(bytes.len() - *at);
+    reader.insert(n).copy_from_slice(&bytes[*at..*at + n]);
+    reader.notify_read(n);
+    *at += n;
+}
+
 /// Calls `f` on every message a streaming reader reaches in `bytes` (a finished or a broken
 /// MCAP file), in file order; returns where the read stopped early, if it did. Errors of `f`
 /// are returned as they are.
@@ -54,10 +62,7 @@ pub fn for_each_readable<E: From<LogError>>(
         let (opcode, data) = match event {
             Err(e) => return Ok(Some(e.to_string())),
             Ok(LinearReadEvent::ReadRequest(need)) => {
-                let n = need.min(bytes.len() - at);
-                reader.insert(n).copy_from_slice(&bytes[at..at + n]);
-                reader.notify_read(n);
-                at += n;
+                feed(&mut reader, bytes, &mut at, need);
                 continue;
             }
             Ok(LinearReadEvent::Record { opcode, data }) => (opcode, data),
@@ -146,12 +151,7 @@ impl Links {
         while let Some(event) = reader.next_event() {
             match event {
                 Err(e) => return Ok(Err(e.to_string())),
-                Ok(LinearReadEvent::ReadRequest(need)) => {
-                    let n = need.min(record.len() - at);
-                    reader.insert(n).copy_from_slice(&record[at..at + n]);
-                    reader.notify_read(n);
-                    at += n;
-                }
+                Ok(LinearReadEvent::ReadRequest(need)) => feed(&mut reader, &record, &mut at, need),
                 Ok(LinearReadEvent::Record { opcode, data }) => {
                     if let Err(e) = self.record(opcode, data, f)? {
                         return Ok(Err(e));
@@ -179,12 +179,7 @@ pub fn check_finished(bytes: &[u8]) -> Result<(), String> {
     let mut at = 0;
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| e.to_string())? {
-            LinearReadEvent::ReadRequest(need) => {
-                let n = need.min(bytes.len() - at);
-                reader.insert(n).copy_from_slice(&bytes[at..at + n]);
-                reader.notify_read(n);
-                at += n;
-            }
+            LinearReadEvent::ReadRequest(need) => feed(&mut reader, bytes, &mut at, need),
             LinearReadEvent::Record { opcode, data } => {
                 mcap::parse_record(opcode, data).map_err(|e| e.to_string())?;
             }
