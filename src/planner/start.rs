@@ -99,7 +99,7 @@ impl Planner {
         let al = self.stage_options();
         let mut z = z0;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
-            if self.over_budget(&tally) {
+            if self.over_budget(tally.evaluations) {
                 tally.status = AlStatus::IterationLimit;
                 break;
             }
@@ -186,9 +186,10 @@ impl Planner {
 }
 
 impl Planner {
-    /// Whether a start has used up its evaluation budget (see [`Planner::budget`]).
-    pub(super) fn over_budget(&self, tally: &Tally) -> bool {
-        self.budget.is_some_and(|b| tally.evaluations >= b)
+    /// Whether a start that has made `evaluations` objective evaluations has used up its
+    /// budget (see [`Planner::budget`]).
+    pub(super) fn over_budget(&self, evaluations: usize) -> bool {
+        self.budget.is_some_and(|b| evaluations >= b)
     }
 }
 
@@ -232,8 +233,7 @@ impl Planner {
         for _ in 0..self.settings.sample_refinements {
             let tunnels = !ver.collision_free(tol);
             let peak = missed_peak(&chosen, &ver);
-            let spent = self.budget.is_some_and(|b| chosen.evaluations >= b);
-            if (!tunnels && !peak) || self.stopped() || spent {
+            if (!tunnels && !peak) || self.stopped() || self.over_budget(chosen.evaluations) {
                 break;
             }
             let worst_k: Vec<f64> = ver

@@ -66,7 +66,7 @@ impl Planner {
             )
         };
         for _ in 0..self.settings.equilibrium_rounds {
-            if self.stopped() || self.over_budget(tally) {
+            if self.stopped() || self.over_budget(tally.evaluations) {
                 break;
             }
             let targets = equilibria(p, z);
