@@ -22,6 +22,7 @@
 //! stays visible where the two coincide. Every JSON schema uses single types only (what
 //! Foxglove's reader accepts): a value that does not exist is left out of the message.
 
+use super::json_schemas;
 use super::scene::{
     color, end_pose, gravity_transform, obstacles_update, rod_thickness, rod_update, time_of_k,
     wall_clock_ns,
@@ -76,27 +77,7 @@ pub struct PlanLog {
     shapes: u64,
 }
 
-/// The JSON schema of `/metrics/*`: single types only. `clearance` (no obstacles),
-/// `deviation`, `stable` and `violation` (replayed shapes only) are left out of a message where
-/// they have no value.
-pub fn metrics_schema() -> serde_json::Value {
-    json!({
-        "type": "object",
-        "properties": {
-            "k": {"type": "number", "description": "path parameter; log time is t0 + 10 k s"},
-            "energy": {"type": "object", "properties": {
-                "total": {"type": "number"}, "flexural": {"type": "number"},
-                "torsional": {"type": "number"}, "extensional": {"type": "number"},
-                "gravitational": {"type": "number"}, "work": {"type": "number"}}},
-            "clearance": {"type": "number", "description": "smallest surface gap to an obstacle (absent without obstacles)"},
-            "deviation": {"type": "number", "description": "replay: largest distance to the plan's shape (case units)"},
-            "stable": {"type": "boolean", "description": "replay: second-order stability (absent when not decided)"},
-            "violation": {"type": "number", "description": "replay: constraint violation of the solve (units of L)"}
-        }
-    })
-}
-
-/// The `/metrics/*` message of one shape (see [`metrics_schema`]).
+/// The `/metrics/*` message of one shape (see [`json_schemas::METRICS`]).
 fn metrics(r: &ShapeRecord) -> serde_json::Value {
     let e = r.energy;
     let mut m = serde_json::Map::new();
@@ -230,7 +211,7 @@ impl PlanObserver for PlanLog {
             w.json(
                 metrics_topic,
                 "dlo.ShapeMetrics",
-                &metrics_schema(),
+                &json_schemas::METRICS,
                 t,
                 &metrics,
             )?;
@@ -238,7 +219,7 @@ impl PlanObserver for PlanLog {
                 w.json(
                     topics::REACTIONS_FEASIBLE,
                     "dlo.Reactions",
-                    &json!({"type": "object"}),
+                    &json_schemas::REACTIONS,
                     t,
                     rj,
                 )?;
@@ -262,7 +243,7 @@ impl PlanObserver for PlanLog {
             w.json(
                 topics::OPTIMISER_PROGRESS,
                 "dlo.OptimiserProgress",
-                &json!({"type": "object"}),
+                &json_schemas::PROGRESS,
                 t,
                 &msg,
             )?;
@@ -303,7 +284,7 @@ pub fn log_static(
     w.json(
         topics::METRICS_SHAPE,
         "dlo.ShapeReport",
-        &json!({"type": "object"}),
+        &json_schemas::SHAPE_REPORT,
         t0,
         metrics,
     )?;
@@ -348,7 +329,7 @@ pub fn log_margin(
         w.json(
             topics::GRASP_LIMITS,
             "dlo.GraspLimit",
-            &json!({"type": "object"}),
+            &json_schemas::GRASP_LIMIT,
             t,
             &serde_json::to_value(lim).expect("limit serialises"),
         )?;

@@ -144,7 +144,9 @@ impl<W: Write + Seek> McapWriter<W> {
         let schema_bytes = serde_json::to_vec(schema).expect("schema serialises");
         let id = self.channel(topic, (name, "jsonschema", &schema_bytes), "json")?;
         self.buf.clear();
-        serde_json::to_writer(&mut self.buf, msg).expect("JSON serialises");
+        // A member without a value is left out, as the schemas say (see `json_schemas`).
+        serde_json::to_writer(&mut self.buf, &super::json_schemas::without_nulls(msg))
+            .expect("JSON serialises");
         self.put(id, log_time)
     }
 
