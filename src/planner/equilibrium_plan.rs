@@ -59,6 +59,11 @@ pub struct EquilibriumPlan {
     /// or `"chords"` (on the chords between them: as the case says, or the replay run again so
     /// after shapes held at the points dipped between them).
     pub contact: &'static str,
+    /// How far (case units) the replay's solves held the rod off the obstacles, on the chords,
+    /// where with the contacts on the obstacles themselves the shapes dipped between contact
+    /// points (absent: not held off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_margin: Option<f64>,
     /// Whose end poses the gripper follows: `"optimal_path"` (the optimal path's, as the
     /// replay) or `"straight_path"` (the straight-line path's, tried when no optimised path is
     /// executable, neither as it stands nor by its equilibria).
@@ -94,6 +99,19 @@ pub(super) fn on_chords(base: &StaticProblem) -> Option<StaticProblem> {
         }
     }
     changed.then_some(out)
+}
+
+/// `base` with every obstacle contact held on the chords between sample points and `margin`
+/// (units of L) further off the obstacle than the rod's radius.
+pub(super) fn held_off(base: &StaticProblem, margin: f64) -> StaticProblem {
+    let mut out = base.clone();
+    for con in out.constraints.iter_mut() {
+        if let Constraint::Obstacle(ob) = con {
+            ob.chords = true;
+            ob.clearance += margin;
+        }
+    }
+    out
 }
 
 /// An observer that passes on only the question whether to stop: the confirmation replay's
@@ -220,6 +238,7 @@ impl Planner {
             } else {
                 "points"
             },
+            contact_margin: None,
             trajectory: "optimal_path",
             optimal_path_not_executable: None,
             dips: false,

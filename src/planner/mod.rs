@@ -43,6 +43,10 @@ pub use result::{PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, 
 use start::Verified;
 use starts::StartPlan;
 
+/// Largest margin (a fraction of the coincidence tolerance) by which replayed equilibria that
+/// dip between contact points are held off the obstacles.
+const CONTACT_MARGIN_CAP: f64 = 0.05;
+
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
 /// obstacles and self-contact), where its controlled end starts and where it goes.
 #[derive(Clone, Debug)]
@@ -518,21 +522,59 @@ impl Planner {
                 .then(|| self.equilibrium_plan(&self.base, path, z, &rep, fine, &mut rec));
         let mut shapes = rec.into_shapes();
         // Equilibria that dip between the solves' contact points: replayed again with the
-        // contacts on the chords between them.
+        // contacts on the chords between them, and where they still dip, held off the obstacles
+        // by twice the depth (at most a twentieth of the coincidence tolerance, so that the
+        // shapes stay well within it of the equilibria on the obstacles themselves).
         if let Some(ep) = equilibrium_plan
             .as_mut()
             .filter(|e| e.dips && !self.stopped())
-            && let Some(chords) = equilibrium_plan::on_chords(&self.base)
         {
-            let mut rec = Recorder::new(observer);
-            let again = self.replay_under(&chords, path, z, &mut rec);
-            let on_chords = self.equilibrium_plan(&chords, path, z, &again, fine, &mut rec);
-            if on_chords.executable {
-                *ep = on_chords;
-                rep = again;
-                shapes = rec.into_shapes();
-            } else if let Some(why) = &on_chords.reason {
-                ep.retry_failed("replayed with contacts on chords", why);
+            let mut attempt = |held: &StaticProblem| {
+                let mut rec = Recorder::new(observer);
+                let again = self.replay_under(held, path, z, &mut rec);
+                let plan = self.equilibrium_plan(held, path, z, &again, fine, &mut rec);
+                (again, plan, rec.into_shapes())
+            };
+            let mut depth = ep.min_clearance.map_or(0.0, |c| -c);
+            if let Some(chords) = equilibrium_plan::on_chords(&self.base) {
+                let (again, on_chords, recorded) = attempt(&chords);
+                if on_chords.executable {
+                    *ep = on_chords;
+                    rep = again;
+                    shapes = recorded;
+                } else {
+                    if let Some(why) = &on_chords.reason {
+                        ep.retry_failed("replayed with contacts on chords", why);
+                    }
+                    depth = if on_chords.dips {
+                        on_chords.min_clearance.map_or(0.0, |c| -c)
+                    } else {
+                        0.0
+                    };
+                }
+            }
+            let l = self.base.model.rod.length;
+            let margin = 2.0 * depth / l;
+            let cap = CONTACT_MARGIN_CAP * self.settings.coincide_tolerance;
+            if !ep.executable && margin > 0.0 && margin <= cap && !self.stopped() {
+                let (again, held, recorded) =
+                    attempt(&equilibrium_plan::held_off(&self.base, margin));
+                if held.executable {
+                    *ep = equilibrium_plan::EquilibriumPlan {
+                        contact_margin: Some(margin * l),
+                        ..held
+                    };
+                    rep = again;
+                    shapes = recorded;
+                } else if let Some(why) = &held.reason {
+                    ep.retry_failed(
+                        &format!(
+                            "replayed on chords held {:.1e} off the obstacles",
+                            margin * l
+                        ),
+                        why,
+                    );
+                }
             }
         }
         let executable = !self.stopped()

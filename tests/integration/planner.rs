@@ -224,8 +224,10 @@ fn replay_reports_where_it_leans_on_obstacles() {
     let c = shipped_variant("plan_paper_planar.json", |v| {
         v["plan"]["safety_margin"] = serde_json::json!(0.0);
         v["plan"]["starts"] = serde_json::json!(1);
-        // The four-term plan that grazes the block, whatever its replay's verdict.
+        // The four-term plan that grazes the block, whatever its replay's verdict, and the
+        // report's replay its own (not replayed equilibria held off the block).
         v["plan"]["fallback_path_terms"] = serde_json::json!([]);
+        v["plan"]["equilibrium_plans"] = serde_json::json!(false);
         // Forces in units of Rf/L² = 3, so that a force missing its unit shows.
         v["rod"]["flexural_rigidity"] = serde_json::json!(3.0);
     });

@@ -167,6 +167,44 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's planar problem `planar_1_8` (seed 1), planned with the defaults: its replayed
+/// equilibria dip into an obstacle between the contact points, and still do with the contacts
+/// on the chords between them. Held off the obstacles by twice that depth (within a twentieth
+/// of the coincidence tolerance), they are the executable plan, checked as above: held at the
+/// trajectory's poses, ending on the goal shape, no shape inside an obstacle on a grid four
+/// times finer in s.
+#[test]
+fn equilibria_that_dip_on_chords_too_are_held_off_by_twice_the_depth() {
+    let (p, r) = suite_planar_plan(8);
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none(), "{e:?}");
+    assert_eq!(e.contact, "chords");
+    let l = p.base.model.rod.length;
+    let margin = e.contact_margin.expect("held off the obstacles");
+    assert!(
+        margin > 0.0 && margin <= 0.05 * p.settings.coincide_tolerance * l,
+        "margin {margin}"
+    );
+    assert!(e.min_clearance.expect("obstacles") > 0.0, "{e:?}");
+    // Complementarity at the margin: a step with a contact force holds the rod the margin off
+    // the obstacle, and a step farther off has none (to 1e-6 L).
+    let tol = 1e-6 * l;
+    let mut leaning = 0;
+    for st in &r.replay.steps {
+        let gap = st.clearance.expect("the problem has obstacles");
+        if st.contact_force > 0.0 {
+            leaning += 1;
+            assert!((gap - margin).abs() < tol, "k = {}: force at {gap}", st.k);
+        }
+        if gap > margin + tol {
+            assert_eq!(st.contact_force, 0.0, "k = {}", st.k);
+        }
+    }
+    assert!(leaning > 0, "no replayed shape leans on an obstacle");
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
 /// The suite's 3D problem `spatial_1_12` (seed 1), planned with the defaults: no optimised path
 /// is executable (the replay of the best ends on another equilibrium of the goal pose), but the equilibria along the
 /// straight-line path's end poses are: the plan follows that trajectory, says why the optimal
