@@ -391,13 +391,18 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         }
         let _ = writeln!(
             o,
-            "  replayed equilibria as the plan: {}; U_max {:.6e} at k = {:.3}{}",
+            "  replayed equilibria as the plan: {}; U_max {:.6e} at k = {:.3}{}{}",
             match &e.reason {
                 None => "executable".to_string(),
                 Some(why) => format!("not executable ({why})"),
             },
             e.u_max,
             e.k_at_u_max,
+            match (e.contact_margin, e.contact) {
+                (Some(m), _) => format!("; contacts on chords, held {m:.2e} off the obstacles"),
+                (None, "chords") => "; contacts on chords".to_string(),
+                _ => String::new(),
+            },
             match (e.confirmation_steps, e.confirmation_deviation_over_l) {
                 (Some(n), Some(d)) =>
                     format!("; a replay on {n} steps reaches them within {d:.2e} L"),
