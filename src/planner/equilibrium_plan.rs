@@ -88,17 +88,10 @@ impl EquilibriumPlan {
 /// `base` with every obstacle contact held on the chords between sample points, or `None` when
 /// it has no obstacle held at its points alone.
 pub(super) fn on_chords(base: &StaticProblem) -> Option<StaticProblem> {
-    let mut out = base.clone();
-    let mut changed = false;
-    for con in out.constraints.iter_mut() {
-        if let Constraint::Obstacle(ob) = con
-            && !ob.chords
-        {
-            ob.chords = true;
-            changed = true;
-        }
-    }
-    changed.then_some(out)
+    base.constraints
+        .iter()
+        .any(|c| matches!(c, Constraint::Obstacle(ob) if !ob.chords))
+        .then(|| held_off(base, 0.0))
 }
 
 /// `base` with every obstacle contact held on the chords between sample points and `margin`

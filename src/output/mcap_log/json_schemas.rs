@@ -116,18 +116,31 @@ pub static GRASP_LIMIT: LazyLock<Value> = LazyLock::new(|| {
         "unconverged": {"type": "integer"}}})
 });
 
-/// `value` with every `null` member of an object left out, at any depth (`null`s inside
-/// arrays stay: leaving them out would move the entries after them).
-pub fn without_nulls(value: &Value) -> Value {
-    match value {
-        Value::Object(m) => Value::Object(
-            m.iter()
-                .filter(|(_, v)| !v.is_null())
-                .map(|(k, v)| (k.clone(), without_nulls(v)))
-                .collect(),
-        ),
-        Value::Array(a) => Value::Array(a.iter().map(without_nulls).collect()),
-        v => v.clone(),
+/// `value` serialised with every `null` member of an object left out, at any depth (`null`s
+/// inside arrays stay: leaving them out would move the entries after them). A view, not a copy:
+/// the writer serialises every JSON message through it.
+pub struct WithoutNulls<'a>(pub &'a Value);
+
+impl serde::Serialize for WithoutNulls<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::{SerializeMap, SerializeSeq};
+        match self.0 {
+            Value::Object(m) => {
+                let mut map = s.serialize_map(None)?;
+                for (k, v) in m.iter().filter(|(_, v)| !v.is_null()) {
+                    map.serialize_entry(k, &WithoutNulls(v))?;
+                }
+                map.end()
+            }
+            Value::Array(a) => {
+                let mut seq = s.serialize_seq(Some(a.len()))?;
+                for v in a {
+                    seq.serialize_element(&WithoutNulls(v))?;
+                }
+                seq.end()
+            }
+            v => v.serialize(s),
+        }
     }
 }
 
@@ -183,6 +196,7 @@ mod tests {
     #[test]
     fn nulls_leave_objects_and_stay_in_arrays() {
         let v = json!({"a": null, "b": {"c": null, "d": 1}, "e": [null, {"f": null}]});
-        assert_eq!(without_nulls(&v), json!({"b": {"d": 1}, "e": [null, {}]}));
+        let written = serde_json::to_value(WithoutNulls(&v)).expect("serialises");
+        assert_eq!(written, json!({"b": {"d": 1}, "e": [null, {}]}));
     }
 }

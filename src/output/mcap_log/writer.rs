@@ -141,11 +141,17 @@ impl<W: Write + Seek> McapWriter<W> {
         log_time: u64,
         msg: &serde_json::Value,
     ) -> Result<(), LogError> {
-        let schema_bytes = serde_json::to_vec(schema).expect("schema serialises");
-        let id = self.channel(topic, (name, "jsonschema", &schema_bytes), "json")?;
+        // The schema is written once, with the topic's channel.
+        let id = match self.channels.get(topic) {
+            Some(&id) => id,
+            None => {
+                let schema_bytes = serde_json::to_vec(schema).expect("schema serialises");
+                self.channel(topic, (name, "jsonschema", &schema_bytes), "json")?
+            }
+        };
         self.buf.clear();
         // A member without a value is left out, as the schemas say (see `json_schemas`).
-        serde_json::to_writer(&mut self.buf, &super::json_schemas::without_nulls(msg))
+        serde_json::to_writer(&mut self.buf, &super::json_schemas::WithoutNulls(msg))
             .expect("JSON serialises");
         self.put(id, log_time)
     }
