@@ -17,6 +17,7 @@ use crate::optim::{Nlp, Sense};
 use crate::planner::clear_samples::ClearSamples;
 use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
+use crate::planner::workers::Workers;
 use crate::rod::energy::Objective;
 use crate::rod::hessian::add_rank_one;
 use crate::rod::kinematics::Shape;
@@ -57,11 +58,34 @@ pub struct MinimaxProblem {
     a: Vec<Vec<f64>>,
     shapes: Vec<Shape>,
     u: Vec<f64>,
-    gu: Vec<Vec<f64>>,
     weights: Vec<f64>,
-    adj: Adjoint,
+    /// Per sample: its own results and scratch, written by whichever thread evaluates it.
+    work: Vec<SampleWork>,
+    /// Threads the samples are split over ([`MinimaxProblem::set_workers`]).
+    workers: Workers,
+}
+
+/// One sample's results and scratch ([`MinimaxProblem`] evaluates the samples on any number of
+/// threads, each into its own slots, and sums them afterwards in sample order).
+#[derive(Clone, Debug)]
+struct SampleWork {
+    /// Interior sample index (its rows start at `index · rows_per_sample`), if interior.
+    interior: Option<usize>,
+    /// Dimensionless energy.
+    u: f64,
+    /// Its gradient in the shape's coefficients.
+    gu: Vec<f64>,
+    /// The sample's rows.
+    rows: Vec<f64>,
+    /// The sample's share of the objective's gradient, in the shape's coefficients.
     ga: Vec<f64>,
+    /// The z-gradient of its energy (Hessian only).
+    gz: Vec<f64>,
+    /// The sample's share of the Hessian in the shape's coefficients (row-major `n×n`).
     ha: Vec<f64>,
+    /// The rows' weights (scratch).
+    y: Vec<f64>,
+    adj: Adjoint,
 }
 
 impl MinimaxProblem {
@@ -90,7 +114,20 @@ impl MinimaxProblem {
             .collect();
         let n = path.n();
         let nk = ks.len();
-        let adj = Adjoint::new(&model);
+        let per = *offsets.last().unwrap();
+        let work = (0..nk)
+            .map(|j| SampleWork {
+                interior: interior.iter().position(|&i| i == j),
+                u: 0.0,
+                gu: vec![0.0; n],
+                rows: vec![0.0; per],
+                ga: vec![0.0; n],
+                gz: Vec::new(),
+                ha: Vec::new(),
+                y: vec![0.0; per],
+                adj: Adjoint::new(&model),
+            })
+            .collect();
         MinimaxProblem {
             model,
             path,
@@ -110,12 +147,16 @@ impl MinimaxProblem {
             a: vec![vec![0.0; n]; nk],
             shapes: vec![Shape::default(); nk],
             u: vec![0.0; nk],
-            gu: vec![vec![0.0; n]; nk],
             weights: vec![0.0; nk],
-            adj,
-            ga: vec![0.0; n],
-            ha: vec![0.0; n * n],
+            work,
+            workers: Workers::serial(),
         }
+    }
+
+    /// Splits the samples' evaluations over `workers`' threads (the results are the same bit
+    /// for bit on any number).
+    pub fn set_workers(&mut self, workers: Workers) {
+        self.workers = workers;
     }
 
     /// Rows per interior sample.
@@ -313,7 +354,9 @@ impl Nlp for MinimaxProblem {
         // The samples' coefficients, which shapes stay left out, then the other shapes.
         let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
-            self.path.shape_at(z, k, &mut self.a[j]);
+            if light {
+                self.path.shape_at(z, k, &mut self.a[j]);
+            }
             let interior = k > 0.0 && k < 1.0;
             let keep = match &self.skip {
                 Some(sk) if light => !interior || sk.clear(i, j, &self.a[j]),
@@ -327,33 +370,39 @@ impl Nlp for MinimaxProblem {
         }
         let left_out =
             |skip: &Option<ClearSamples>, j: usize| skip.as_ref().is_some_and(|sk| sk.stale[j]);
-        let skip = &self.skip;
-        self.model
-            .evaluate_many(&self.a, &mut self.shapes, |j| !left_out(skip, j));
-        for (j, &k) in self.ks.iter().enumerate() {
-            let interior = k > 0.0 && k < 1.0;
-            let keep = left_out(&self.skip, j);
-            self.gu[j].iter_mut().for_each(|g| *g = 0.0);
-            let t = self.model.energy(
-                &self.a[j],
-                &self.shapes[j],
-                self.objective,
-                Some(&mut self.gu[j]),
-            );
-            self.u[j] = t.value(self.objective);
-            if interior {
-                let rows = &mut c[row..row + per];
-                match (&mut self.skip, keep) {
-                    (Some(sk), true) => rows.copy_from_slice(sk.rows(j)),
-                    (skip, _) => {
-                        for (b, blk) in self.blocks.iter().enumerate() {
-                            blk.values(
-                                &self.model,
-                                &self.a[j],
-                                &self.shapes[j],
-                                &mut rows[self.offsets[b]..self.offsets[b + 1]],
-                            );
+        {
+            let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
+            let (path, ks, skip, objective) = (&self.path, &self.ks, &self.skip, self.objective);
+            let (a, shapes, work) = (&mut self.a, &mut self.shapes, &mut self.work);
+            self.workers
+                .for_each_chunk3(a, shapes, work, |j0, a, shapes, work| {
+                    if !light {
+                        for (i, ai) in a.iter_mut().enumerate() {
+                            path.shape_at(z, ks[j0 + i], ai);
                         }
+                    }
+                    model.evaluate_many(a, shapes, |i| !left_out(skip, j0 + i));
+                    for (i, (shape, w)) in shapes.iter().zip(work.iter_mut()).enumerate() {
+                        w.gu.iter_mut().for_each(|g| *g = 0.0);
+                        let t = model.energy(&a[i], shape, objective, Some(&mut w.gu));
+                        w.u = t.value(objective);
+                        if w.interior.is_some() && !left_out(skip, j0 + i) {
+                            for (b, blk) in blocks.iter().enumerate() {
+                                let rows = &mut w.rows[offsets[b]..offsets[b + 1]];
+                                blk.values(model, &a[i], shape, rows);
+                            }
+                        }
+                    }
+                });
+        }
+        for (j, w) in self.work.iter().enumerate() {
+            self.u[j] = w.u;
+            if w.interior.is_some() {
+                let rows = &mut c[row..row + per];
+                match &mut self.skip {
+                    Some(sk) if sk.stale[j] => rows.copy_from_slice(sk.rows(j)),
+                    skip => {
+                        rows.copy_from_slice(&w.rows);
                         if let Some(sk) = skip {
                             sk.record(j, &self.a[j], rows);
                         }
@@ -384,59 +433,58 @@ impl Nlp for MinimaxProblem {
             }
         }
         let nk = self.ks.len() as f64;
-        let mut row = 0;
         let n_sample_rows = self.sample_rows();
-        let mut yeff = vec![0.0; per];
         let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&j| &self.shapes[j]).collect();
-        for (j, &k) in self.ks.iter().enumerate() {
-            let wj = self.weights[j] + self.mean_weight / nk;
-            for (ga, gu) in self.ga.iter_mut().zip(&self.gu[j]) {
-                *ga = wj * gu;
-            }
-            if k > 0.0 && k < 1.0 {
-                yeff.copy_from_slice(&y[row..row + per]);
-                self.adj.clear();
-                let swept_any = self.swept.as_ref().is_some_and(|sw| {
-                    let (i, ys) = (row / per, &y[n_sample_rows..]);
-                    sw.add_chord_cotangents(i, ys, &interior_shapes, &mut self.adj);
-                    sw.add_sample_weights(i, ys, &self.offsets, &mut yeff)
+        let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
+        let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
+        let (swept, targets) = (&self.swept, &self.targets);
+        let tracked = targets.is_some() && self.track_weight > 0.0;
+        let (travel_weight, track_weight, mean_weight) =
+            (self.travel_weight, self.track_weight, self.mean_weight);
+        let travel = travel_weight != 0.0;
+        let end = model.mesh.boundaries.len() - 1;
+        self.workers.for_each_chunk(&mut self.work, |j0, work| {
+            for (i, w) in work.iter_mut().enumerate() {
+                let j = j0 + i;
+                let wj = weights[j] + mean_weight / nk;
+                for (ga, gu) in w.ga.iter_mut().zip(&w.gu) {
+                    *ga = wj * gu;
+                }
+                let Some(ii) = w.interior else { continue };
+                let row = ii * per;
+                w.y.copy_from_slice(&y[row..row + per]);
+                w.adj.clear();
+                let swept_any = swept.as_ref().is_some_and(|sw| {
+                    let ys = &y[n_sample_rows..];
+                    sw.add_chord_cotangents(ii, ys, &interior_shapes, &mut w.adj);
+                    sw.add_sample_weights(ii, ys, offsets, &mut w.y)
                 });
-                let yj = &yeff;
-                let tracked = self.targets.is_some() && self.track_weight > 0.0;
-                let travel = self.travel_weight != 0.0;
-                if tracked || travel || swept_any || yj.iter().any(|v| *v != 0.0) {
-                    for (b, blk) in self.blocks.iter().enumerate() {
-                        let w = &yj[self.offsets[b]..self.offsets[b + 1]];
-                        if w.iter().any(|v| *v != 0.0) {
-                            blk.add_gradient(
-                                &self.model,
-                                &self.a[j],
-                                &self.shapes[j],
-                                w,
-                                &mut self.adj,
-                            );
+                if tracked || travel || swept_any || w.y.iter().any(|v| *v != 0.0) {
+                    for (b, blk) in blocks.iter().enumerate() {
+                        let wb = &w.y[offsets[b]..offsets[b + 1]];
+                        if wb.iter().any(|v| *v != 0.0) {
+                            blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
                         }
                     }
-                    if let (true, Some(t)) = (tracked, &self.targets) {
+                    if let (true, Some(t)) = (tracked, targets) {
                         let tj = &t[j];
-                        let wt = self.track_weight / tj.len() as f64;
-                        for (b, (x, xb)) in self.shapes[j].positions.iter().zip(tj).enumerate() {
-                            self.adj
+                        let wt = track_weight / tj.len() as f64;
+                        for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
+                            w.adj
                                 .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
                         }
                     }
                     if travel {
-                        let end = self.model.mesh.boundaries.len() - 1;
-                        let d =
-                            travel_cotangent(self.travel_weight, &self.ks, &self.shapes, end, j);
-                        self.adj.add_pos(end, 1.0, d);
+                        let d = travel_cotangent(travel_weight, ks, shapes, end, j);
+                        w.adj.add_pos(end, 1.0, d);
                     }
-                    self.adj.finish(&self.model, &self.shapes[j], &mut self.ga);
+                    w.adj.finish(model, &shapes[j], &mut w.ga);
                 }
-                row += per;
             }
-            if k > 0.0 && k < 1.0 {
-                self.path.add_chain(&self.ga, k, g);
+        });
+        for (w, &k) in self.work.iter().zip(&self.ks) {
+            if w.interior.is_some() {
+                self.path.add_chain(&w.ga, k, g);
             }
         }
     }
@@ -457,53 +505,66 @@ impl Nlp for MinimaxProblem {
         let nk = self.ks.len() as f64;
         let tracked = self.targets.is_some() && self.track_weight > 0.0;
         // Softmax part: β (Σ w g gᵀ − ḡ ḡᵀ) with g the z-gradients of the samples.
-        let mut gz = vec![vec![0.0; nv]; self.ks.len()];
         let mut gbar = vec![0.0; nv];
-        let mut row = 0;
         let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
         let ns = self.sample_rows();
-        for (j, &k) in self.ks.iter().enumerate() {
-            if !(k > 0.0 && k < 1.0) {
-                continue;
-            }
-            self.path.add_chain(&self.gu[j], k, &mut gz[j]);
-            for (b, v) in gbar.iter_mut().zip(&gz[j]) {
-                *b += self.weights[j] * v;
-            }
-            let ha = &mut self.ha;
-            ha.iter_mut().for_each(|v| *v = 0.0);
-            let wj = self.weights[j] + self.mean_weight / nk;
-            let (model, shape) = (&self.model, &self.shapes[j]);
-            model.add_energy_hessian(shape, self.objective, wj, ha);
-            let (blocks, offsets, aj) = (&self.blocks, &self.offsets, &self.a[j]);
-            let mut yj = y[row..row + per].to_vec();
-            // The swept rows' share of this sample's obstacle rows, and their chord terms.
-            if let Some(sw) = &self.swept {
-                sw.add_sample_weights(row / per, &y[ns..], offsets, &mut yj);
-            }
-            add_weighted_curvature(blocks, offsets, model, aj, shape, &yj, &mut self.adj, ha);
-            if let Some(sw) = &self.swept {
-                sw.add_chord_cotangents(row / per, &y[ns..], &interior_shapes, &mut self.adj);
-            }
-            if let (true, Some(t)) = (tracked, &self.targets) {
-                let tj = &t[j];
-                let wt = self.track_weight / tj.len() as f64;
-                for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
-                    self.adj
-                        .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+        let n = self.model.n();
+        let (model, blocks, offsets, path) = (&self.model, &self.blocks, &self.offsets, &self.path);
+        let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
+        let (swept, targets, objective) = (&self.swept, &self.targets, self.objective);
+        let (travel_weight, track_weight, mean_weight) =
+            (self.travel_weight, self.track_weight, self.mean_weight);
+        self.workers.for_each_chunk(&mut self.work, |j0, work| {
+            for (i, w) in work.iter_mut().enumerate() {
+                let j = j0 + i;
+                let k = ks[j];
+                w.gz.clear();
+                w.gz.resize(nv, 0.0);
+                let Some(ii) = w.interior else { continue };
+                let row = ii * per;
+                path.add_chain(&w.gu, k, &mut w.gz);
+                let ha = &mut w.ha;
+                ha.clear();
+                ha.resize(n * n, 0.0);
+                let wj = weights[j] + mean_weight / nk;
+                let shape = &shapes[j];
+                model.add_energy_hessian(shape, objective, wj, ha);
+                let aj = &a[j];
+                w.y.copy_from_slice(&y[row..row + per]);
+                // The swept rows' share of this sample's obstacle rows, and their chord terms.
+                if let Some(sw) = swept {
+                    sw.add_sample_weights(ii, &y[ns..], offsets, &mut w.y);
                 }
-                model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
+                add_weighted_curvature(blocks, offsets, model, aj, shape, &w.y, &mut w.adj, ha);
+                if let Some(sw) = swept {
+                    sw.add_chord_cotangents(ii, &y[ns..], &interior_shapes, &mut w.adj);
+                }
+                if let (true, Some(t)) = (tracked, targets) {
+                    let tj = &t[j];
+                    let wt = track_weight / tj.len() as f64;
+                    for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
+                        w.adj
+                            .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                    }
+                    model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
+                }
+                if travel_weight != 0.0 {
+                    let end = model.mesh.boundaries.len() - 1;
+                    let d = travel_cotangent(travel_weight, ks, shapes, end, j);
+                    w.adj.add_pos(end, 1.0, d);
+                }
+                w.adj.finish_hessian(model, shape, ha);
+                let sj = &s[row..row + per];
+                add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut w.adj, ha);
             }
-            if self.travel_weight != 0.0 {
-                let end = model.mesh.boundaries.len() - 1;
-                let d = travel_cotangent(self.travel_weight, &self.ks, &self.shapes, end, j);
-                self.adj.add_pos(end, 1.0, d);
+        });
+        for (j, w) in self.work.iter().enumerate() {
+            if w.interior.is_some() {
+                for (b, v) in gbar.iter_mut().zip(&w.gz) {
+                    *b += self.weights[j] * v;
+                }
+                self.path.add_chain_hessian(&w.ha, self.ks[j], 1.0, h);
             }
-            self.adj.finish_hessian(model, shape, ha);
-            let sj = &s[row..row + per];
-            add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut self.adj, ha);
-            self.path.add_chain_hessian(ha, k, 1.0, h);
-            row += per;
         }
         if let Some(sw) = &self.swept {
             let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
@@ -551,8 +612,8 @@ impl Nlp for MinimaxProblem {
                 }
             }
         }
-        for (j, g) in gz.iter().enumerate() {
-            add_rank_one(h, self.beta * self.weights[j], g);
+        for (j, w) in self.work.iter().enumerate() {
+            add_rank_one(h, self.beta * self.weights[j], &w.gz);
         }
         add_rank_one(h, -self.beta, &gbar);
     }

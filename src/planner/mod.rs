@@ -20,6 +20,7 @@ pub mod swept;
 mod tracking;
 pub mod trajectory;
 pub mod verify;
+pub mod workers;
 
 use crate::constraints::{Angle, Constraint};
 pub use crate::error::SettingsError;
@@ -136,6 +137,9 @@ pub struct Planner {
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
     /// the case's own ([`PlanSettings::fallback_evaluations`]).
     budget: Option<usize>,
+    /// Threads a start's path optimisation splits its samples over
+    /// ([`PlanSettings::threads`]).
+    workers: workers::Workers,
 }
 
 /// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
@@ -661,13 +665,14 @@ impl Planner {
         Ok(Planner {
             base: problem.statics,
             obstacles: problem.obstacles,
-            settings,
             static_options,
             start,
             goal,
             linear_rows,
             stop: Arc::new(AtomicBool::new(false)),
             budget: None,
+            workers: workers::Workers::new(settings.threads()),
+            settings,
         })
     }
 

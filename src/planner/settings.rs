@@ -57,6 +57,11 @@ pub struct PlanSettings {
     /// Starts run side by side in groups of this many; a group runs only when no plan of an
     /// earlier group is executable (default: all starts at once).
     pub parallel_starts: Option<usize>,
+    /// Threads a start's path optimisation splits its sampled shapes over (the plan is the same
+    /// bit for bit on any number). Default (absent): every core the process may use, at most
+    /// 4; set 1 where several plans run side by side (a batch, a process pool). Starts that
+    /// run side by side take one each.
+    pub threads: Option<usize>,
     /// Seed of the starts' pseudo-random perturbations.
     pub seed: u64,
     /// Size (radians) of the extra starts' perturbations.
@@ -132,6 +137,7 @@ impl Default for PlanSettings {
             sharpness: d_sharp(),
             starts: d_starts(),
             parallel_starts: None,
+            threads: None,
             seed: d_seed(),
             start_spread: d_spread(),
             sample_refinements: d_sample_ref(),
@@ -187,6 +193,11 @@ impl PlanSettings {
                     format!("must be in {terms_lo}..={terms_hi}, got {t}"),
                 ));
             }
+        }
+        if let Some(t) = self.threads
+            && !(1..=256).contains(&t)
+        {
+            return Err(bad("threads", format!("must be in 1..=256, got {t}")));
         }
         let parallel_starts = self.parallel_starts();
         if !(1..=self.starts).contains(&parallel_starts) {
@@ -336,6 +347,13 @@ impl PlanSettings {
     /// Starts run side by side: `parallel_starts`, or all of them.
     pub fn parallel_starts(&self) -> usize {
         self.parallel_starts.unwrap_or(self.starts)
+    }
+
+    /// Threads a start's path optimisation uses: `threads`, or the cores this process may use
+    /// (at most 4).
+    pub fn threads(&self) -> usize {
+        self.threads
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get().min(4)))
     }
 }
 

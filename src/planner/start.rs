@@ -7,6 +7,7 @@
 
 use super::observer::Progress;
 use super::verify::Verification;
+use super::workers::Workers;
 use super::{Planner, settings};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
 
@@ -76,9 +77,11 @@ impl Planner {
         z0: Vec<f64>,
         ks: &[f64],
         first_stage: usize,
+        workers: &Workers,
         sink: &mut dyn FnMut(Progress, Vec<f64>),
     ) -> StartRun {
         let mut p = self.minimax_problem_at(ks.to_vec());
+        p.set_workers(workers.clone());
         let unit = self.base.model.rod.energy_unit();
         let mut c = vec![0.0; crate::optim::Nlp::m(&p)];
         // Energy scale of the sharpness: the straight path's largest sampled energy.
@@ -214,6 +217,7 @@ impl Planner {
         run: StartRun,
         uniform: &[f64],
         check: &(dyn Fn(&[f64]) -> Verification + Sync),
+        workers: &Workers,
         sink: &mut dyn FnMut(Progress, Vec<f64>),
     ) -> Verified {
         let tol = self.collision_tolerance();
@@ -270,7 +274,7 @@ impl Planner {
             }
             // Warm: only the sharpest stage again.
             let last = self.settings.sharpness.len() - 1;
-            let r = self.optimise_from(start, chosen.z.clone(), &ks, last, sink);
+            let r = self.optimise_from(start, chosen.z.clone(), &ks, last, workers, sink);
             chosen = StartRun {
                 evaluations: chosen.evaluations + r.evaluations,
                 ..r

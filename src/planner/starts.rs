@@ -190,8 +190,8 @@ impl Planner {
                 self.poll(observer);
             };
             let (i, z0) = starts[0].clone();
-            let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
-            vec![self.refine(i, run, uniform, check, &mut sink)]
+            let run = self.optimise_from(i, z0, uniform, 0, &self.workers, &mut sink);
+            vec![self.refine(i, run, uniform, check, &self.workers, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
@@ -218,8 +218,11 @@ impl Planner {
                             idx.into_iter()
                                 .map(|j| {
                                     let (i, z0) = starts[j].clone();
-                                    let run = self.optimise_from(i, z0, uniform, 0, &mut sink);
-                                    (j, self.refine(i, run, uniform, check, &mut sink))
+                                    // The starts already share the cores.
+                                    let one = super::workers::Workers::serial();
+                                    let run =
+                                        self.optimise_from(i, z0, uniform, 0, &one, &mut sink);
+                                    (j, self.refine(i, run, uniform, check, &one, &mut sink))
                                 })
                                 .collect::<Vec<_>>()
                         })

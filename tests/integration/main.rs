@@ -24,5 +24,6 @@ mod self_contact;
 #[allow(dead_code)]
 mod suite;
 mod suite_sample;
+mod threads;
 mod turned_scenes;
 mod wide_kernels;

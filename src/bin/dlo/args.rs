@@ -64,6 +64,11 @@ pub(crate) enum Command {
         /// With `--max-speed`: the end also turns at most this fast (rad/s; default unlimited).
         #[arg(long, value_name = "RAD_PER_S", requires = "max_speed")]
         max_angular_speed: Option<f64>,
+        /// Threads of each plan's path optimisation (instead of the case's `plan.threads`;
+        /// the plan is the same on any number). A batch that runs several cases at a time
+        /// gives each plan one unless this says otherwise.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+        threads: Option<u16>,
     },
     /// Disturbance force margin of a grasp (the case's `grasp` section, paper §6): `F_mub` for
     /// each friction coefficient, where and in which direction it is attained.

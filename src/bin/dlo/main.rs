@@ -98,6 +98,7 @@ fn run() -> ExitCode {
             log_dir,
             max_speed,
             max_angular_speed,
+            threads,
         } => {
             let speeds = match speed_limits(max_speed, max_angular_speed) {
                 Ok(s) => s,
@@ -112,8 +113,13 @@ fn run() -> ExitCode {
                     extra.extend([flag.to_string(), v.to_string()]);
                 }
             }
+            // Cases that run side by side share the cores: one thread each unless told.
+            let side_by_side = jobs.unwrap_or_else(cores) > 1;
+            if let Some(t) = threads.or(side_by_side.then_some(1)) {
+                extra.extend(["--threads".to_string(), t.to_string()]);
+            }
             match single("plan", &cases, Some("plan"), json, jobs, &extra) {
-                Ok(case) => run_plan(&case, json, plot, &log_dir, speeds),
+                Ok(case) => run_plan(&case, json, plot, &log_dir, speeds, threads),
                 Err(code) => code,
             }
         }
@@ -178,8 +184,18 @@ fn single(
         eprintln!("error: {e}");
         ExitCode::from(EXIT_BAD_INPUT)
     })?;
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    Err(batch::run(command, &files, extra, json, jobs))
+    Err(batch::run(
+        command,
+        &files,
+        extra,
+        json,
+        jobs.unwrap_or_else(cores),
+    ))
+}
+
+/// The cores this process may use.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 fn load(path: &std::path::Path) -> Result<Case, ExitCode> {

@@ -69,14 +69,19 @@ pub(crate) fn run_plan(
     plot: bool,
     log_dir: &Path,
     speeds: Option<[f64; 2]>,
+    threads: Option<u16>,
 ) -> ExitCode {
     let c = match load(path) {
         Ok(c) => c,
         Err(code) => return code,
     };
     let t0 = Instant::now();
-    let built =
-        case::plan::plan_problem(&c).map(|(problem, settings)| Planner::new(problem, settings));
+    let built = case::plan::plan_problem(&c).map(|(problem, mut settings)| {
+        if let Some(t) = threads {
+            settings.threads = Some(usize::from(t));
+        }
+        Planner::new(problem, settings)
+    });
     let planner = match built {
         Ok(Ok(p)) => p,
         Ok(Err(PlanSetupError::Unreachable { end, message })) => {

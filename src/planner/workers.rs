@@ -1,0 +1,310 @@
+//! The threads a path optimisation splits its sampled shapes over: the calling thread and
+//! helper threads the planner owns ([`super::PlanSettings::threads`]). Work is cut into fixed
+//! chunks of samples whatever the number of threads, every sample's results are written to its
+//! own slots, and whatever adds samples together runs afterwards on the calling thread in
+//! sample order: a plan is the same bit for bit on any number of threads. A planar
+//! evaluation takes a tenth of a millisecond, about what waking a sleeping thread costs, so an
+//! idle helper keeps looking for work for a while before it sleeps, and each thread takes the
+//! same share of the samples at every call (their data stays in its core's cache).
+
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Samples per chunk: a multiple of the four shapes the planar kinematics advance side by side.
+pub const CHUNK: usize = 4;
+
+/// How long an idle helper keeps looking for the next piece of work before it sleeps: longer
+/// than the optimiser's own work between two evaluations, so that a helper is awake when the
+/// next one starts (waking a sleeping thread costs about as much as a planar evaluation).
+const SPIN: Duration = Duration::from_micros(100);
+
+/// Where chunks of work run: on the calling thread alone, or also on helper threads that live
+/// as long as the planner.
+#[derive(Clone, Default)]
+pub struct Workers {
+    team: Option<Arc<Team>>,
+}
+
+impl std::fmt::Debug for Workers {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Workers({})", self.threads())
+    }
+}
+
+/// A job as the helpers see it: the calling thread's closure, which outlives every call a
+/// helper makes (see [`Workers::run`]).
+#[derive(Clone, Copy)]
+struct JobPtr(*const (dyn Fn(usize) + Sync));
+// SAFETY: the pointee is `Sync`, and `Workers::run` keeps it alive while any helper may call it.
+unsafe impl Send for JobPtr {}
+
+#[derive(Default)]
+struct Shared {
+    /// The job, while `open`.
+    job: Mutex<Option<JobPtr>>,
+    /// Bumped for every job posted.
+    epoch: AtomicU64,
+    /// Whether helpers may still enter the current job.
+    open: AtomicBool,
+    /// Helpers inside the current job.
+    active: AtomicUsize,
+    /// A helper's job panicked.
+    panicked: AtomicBool,
+    shutdown: AtomicBool,
+}
+
+struct Team {
+    /// Held while a job runs: one job at a time (a second caller runs its chunks alone).
+    busy: Mutex<()>,
+    shared: Arc<Shared>,
+    helpers: Vec<(std::thread::JoinHandle<()>, Arc<AtomicBool>)>,
+}
+
+impl Drop for Team {
+    fn drop(&mut self) {
+        self.shared.shutdown.store(true, SeqCst);
+        for (h, _) in self.helpers.drain(..) {
+            h.thread().unpark();
+            let _ = h.join();
+        }
+    }
+}
+
+fn helper(index: usize, shared: Arc<Shared>, sleeping: Arc<AtomicBool>) {
+    let mut seen = shared.epoch.load(SeqCst);
+    loop {
+        // Wait for a new job: look for it for a while, then sleep until woken.
+        let since = Instant::now();
+        loop {
+            if shared.shutdown.load(SeqCst) {
+                return;
+            }
+            if shared.epoch.load(SeqCst) != seen {
+                break;
+            }
+            if since.elapsed() < SPIN {
+                std::hint::spin_loop();
+                continue;
+            }
+            sleeping.store(true, SeqCst);
+            if shared.epoch.load(SeqCst) == seen && !shared.shutdown.load(SeqCst) {
+                std::thread::park();
+            }
+            sleeping.store(false, SeqCst);
+        }
+        seen = shared.epoch.load(SeqCst);
+        // Enter only while the job is open: the calling thread, once it has closed the job,
+        // waits for every helper that entered before it may drop the closure.
+        shared.active.fetch_add(1, SeqCst);
+        if shared.open.load(SeqCst) {
+            let job = *shared.job.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(JobPtr(f)) = job {
+                // SAFETY: the job is open and this helper is counted in `active`, so the
+                // closure is alive until this helper leaves (see `Workers::run`).
+                let f = unsafe { &*f };
+                if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(index))).is_err() {
+                    shared.panicked.store(true, SeqCst);
+                }
+            }
+        }
+        shared.active.fetch_sub(1, SeqCst);
+    }
+}
+
+impl Workers {
+    /// The calling thread alone.
+    pub fn serial() -> Workers {
+        Workers { team: None }
+    }
+
+    /// The calling thread and `threads − 1` helpers (the calling thread alone for 0 or 1, or
+    /// when no thread can be started).
+    pub fn new(threads: usize) -> Workers {
+        if threads <= 1 {
+            return Workers::serial();
+        }
+        let shared = Arc::new(Shared::default());
+        let helpers: Vec<_> = (1..threads)
+            .filter_map(|i| {
+                let sleeping = Arc::new(AtomicBool::new(false));
+                let (sh, sl) = (shared.clone(), sleeping.clone());
+                std::thread::Builder::new()
+                    .name(format!("dlo-plan-{i}"))
+                    .spawn(move || helper(i, sh, sl))
+                    .ok()
+                    .map(|h| (h, sleeping))
+            })
+            .collect();
+        if helpers.is_empty() {
+            return Workers::serial();
+        }
+        Workers {
+            team: Some(Arc::new(Team {
+                busy: Mutex::new(()),
+                shared,
+                helpers,
+            })),
+        }
+    }
+
+    /// Threads that take part, the calling one included.
+    pub fn threads(&self) -> usize {
+        1 + self.team.as_ref().map_or(0, |t| t.helpers.len())
+    }
+
+    /// Runs `f(0)` on the calling thread and `f(i)` on every helper `i` that joins in before
+    /// the calling thread's own call returns; returns once no helper is inside `f` any more.
+    fn run(&self, team: &Team, f: &(dyn Fn(usize) + Sync)) {
+        let shared = &team.shared;
+        // SAFETY (lifetime): the pointer is erased to `'static` for the helpers; they call it
+        // only while the job is open or they are counted in `active`, and this function
+        // closes the job and waits for `active` to reach zero before it returns.
+        let ptr: *const (dyn Fn(usize) + Sync + '_) = f;
+        let ptr: *const (dyn Fn(usize) + Sync) = unsafe { std::mem::transmute(ptr) };
+        *shared.job.lock().unwrap_or_else(|e| e.into_inner()) = Some(JobPtr(ptr));
+        shared.open.store(true, SeqCst);
+        shared.epoch.fetch_add(1, SeqCst);
+        for (h, sleeping) in &team.helpers {
+            if sleeping.load(SeqCst) {
+                h.thread().unpark();
+            }
+        }
+        let mine = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(0)));
+        shared.open.store(false, SeqCst);
+        let mut spins = 0u32;
+        while shared.active.load(SeqCst) != 0 {
+            spins += 1;
+            if spins < 1 << 12 {
+                std::hint::spin_loop();
+            } else {
+                std::thread::yield_now();
+            }
+        }
+        *shared.job.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        if let Err(p) = mine {
+            std::panic::resume_unwind(p);
+        }
+        if shared.panicked.swap(false, SeqCst) {
+            panic!("a planner thread panicked");
+        }
+    }
+
+    /// Calls `f(j0, a_chunk)` on every chunk of [`CHUNK`] items of `a`, `j0` being the chunk's
+    /// first index; the calling thread takes part and returns when every chunk is done.
+    pub fn for_each_chunk<A: Send>(&self, a: &mut [A], f: impl Fn(usize, &mut [A]) + Sync) {
+        let mut b = vec![(); a.len()];
+        let mut c = vec![(); a.len()];
+        self.for_each_chunk3(a, &mut b, &mut c, |j0, a, _, _| f(j0, a));
+    }
+
+    /// [`Workers::for_each_chunk`] on the same chunks of three slices of the same length.
+    pub fn for_each_chunk3<A: Send, B: Send, C: Send>(
+        &self,
+        a: &mut [A],
+        b: &mut [B],
+        c: &mut [C],
+        f: impl Fn(usize, &mut [A], &mut [B], &mut [C]) + Sync,
+    ) {
+        debug_assert!(a.len() == b.len() && a.len() == c.len());
+        // The team runs one job at a time: a clone of these workers used on another thread
+        // meanwhile runs its chunks alone.
+        let team = self.team.as_ref().filter(|_| a.len() > CHUNK);
+        let busy = team.and_then(|t| t.busy.try_lock().ok());
+        let (Some(team), Some(_busy)) = (team, busy) else {
+            let chunks = a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK));
+            for (i, ((x, y), z)) in chunks.zip(c.chunks_mut(CHUNK)).enumerate() {
+                f(i * CHUNK, x, y, z);
+            }
+            return;
+        };
+        type Piece<'a, A, B, C> = Mutex<Option<((&'a mut [A], &'a mut [B]), &'a mut [C])>>;
+        let pieces: Vec<Piece<A, B, C>> = a
+            .chunks_mut(CHUNK)
+            .zip(b.chunks_mut(CHUNK))
+            .zip(c.chunks_mut(CHUNK))
+            .map(|p| Mutex::new(Some(p)))
+            .collect();
+        // Thread `t` of `n` takes its own share of the chunks first (the same share at every
+        // call, so that a sample's data stays in one core's cache), then whatever is left.
+        let n = self.threads();
+        let share = pieces.len().div_ceil(n);
+        let work = |t: usize| {
+            let own = (t * share).min(pieces.len())..((t + 1) * share).min(pieces.len());
+            for i in own.chain(0..pieces.len()) {
+                let taken = pieces[i].lock().map(|mut p| p.take());
+                if let Ok(Some(((x, y), z))) = taken {
+                    f(i * CHUNK, x, y, z);
+                }
+            }
+        };
+        self.run(team, &work);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_chunk_runs_once_with_its_first_index() {
+        for threads in [1, 2, 3] {
+            let w = Workers::new(threads);
+            for n in [0, 1, 4, 5, 41] {
+                let mut a: Vec<usize> = vec![0; n];
+                let mut b: Vec<usize> = vec![0; n];
+                let mut c: Vec<usize> = vec![0; n];
+                w.for_each_chunk3(&mut a, &mut b, &mut c, |j0, x, y, z| {
+                    for (i, u) in x.iter_mut().enumerate() {
+                        *u += j0 + i;
+                    }
+                    y.iter_mut().for_each(|v| *v += 1);
+                    z.iter_mut().for_each(|v| *v += 2);
+                });
+                assert_eq!(a, (0..n).collect::<Vec<_>>(), "threads {threads}, n {n}");
+                assert!(b.iter().all(|&v| v == 1) && c.iter().all(|&v| v == 2));
+            }
+        }
+    }
+
+    #[test]
+    fn a_panic_on_any_thread_reaches_the_caller_and_the_workers_go_on() {
+        let w = Workers::new(2);
+        for bad in [0, 40] {
+            let mut a = vec![0usize; 41];
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                w.for_each_chunk(&mut a, |j0, x| {
+                    if (j0..j0 + x.len()).contains(&bad) {
+                        panic!("chunk with {bad}");
+                    }
+                    x.iter_mut().for_each(|v| *v = 1);
+                })
+            }));
+            assert!(r.is_err(), "the panic at sample {bad} is lost");
+        }
+        let mut a = vec![0usize; 41];
+        w.for_each_chunk(&mut a, |_, x| x.iter_mut().for_each(|v| *v = 1));
+        assert!(a.iter().all(|&v| v == 1));
+    }
+
+    #[test]
+    fn clones_used_on_several_threads_at_once_each_get_every_chunk() {
+        let w = Workers::new(2);
+        std::thread::scope(|sc| {
+            for t in 0..4 {
+                let w = w.clone();
+                sc.spawn(move || {
+                    for _ in 0..200 {
+                        let mut a = vec![0usize; 41];
+                        w.for_each_chunk(&mut a, |j0, x| {
+                            for (i, v) in x.iter_mut().enumerate() {
+                                *v = t + j0 + i;
+                            }
+                        });
+                        assert!(a.iter().enumerate().all(|(i, &v)| v == t + i));
+                    }
+                });
+            }
+        });
+    }
+}
