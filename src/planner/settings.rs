@@ -349,11 +349,30 @@ impl PlanSettings {
         self.parallel_starts.unwrap_or(self.starts)
     }
 
-    /// Threads a start's path optimisation uses: `threads`, or the cores this process may use
-    /// (at most 4).
+    /// Threads a start's path optimisation uses: `threads`; else the environment variable
+    /// `DLO_THREADS` when it is a number in 1..=256 ([`env_threads`]); else the cores this
+    /// process may use, at most 4.
     pub fn threads(&self) -> usize {
         self.threads
+            .or_else(|| env_threads().ok().flatten())
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get().min(4)))
+    }
+}
+
+/// The environment variable `DLO_THREADS`: the default of [`PlanSettings::threads`] where a
+/// case or a program does not set it (e.g. 1 for every plan of a job array or a test run
+/// that already keeps the cores busy). `Ok(None)` when it is unset; `Err` says why a value is
+/// not a number in 1..=256 (the default then ignores it).
+pub fn env_threads() -> Result<Option<usize>, String> {
+    match std::env::var("DLO_THREADS") {
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(e) => Err(format!("DLO_THREADS: {e}")),
+        Ok(v) => match v.trim().parse::<usize>() {
+            Ok(n) if (1..=256).contains(&n) => Ok(Some(n)),
+            _ => Err(format!(
+                "DLO_THREADS: must be a number in 1..=256, got {v:?}"
+            )),
+        },
     }
 }
 

@@ -64,3 +64,27 @@ fn plans_are_the_same_on_one_two_and_three_threads() {
         }
     }
 }
+
+/// `DLO_THREADS` sets the default; a value that is not a number in 1..=256 is bad input (exit
+/// 2, naming the variable), before anything is planned or written.
+#[test]
+fn a_bad_dlo_threads_is_bad_input() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let logs = root.join("target/test-logs/threads_env");
+    for bad in ["0", "x", "300"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
+            .args(["plan", "planning_cases/plan_paper_planar.json", "--log-dir"])
+            .arg(&logs)
+            .current_dir(root)
+            .env("DLO_THREADS", bad)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        assert!(
+            err.contains("DLO_THREADS") && !err.contains("panicked"),
+            "{err}"
+        );
+        assert!(!logs.join("plan_paper_planar.mcap").exists());
+    }
+}

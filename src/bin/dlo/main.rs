@@ -113,9 +113,16 @@ fn run() -> ExitCode {
                     extra.extend([flag.to_string(), v.to_string()]);
                 }
             }
+            let env = match dlo_planner::planner::settings::env_threads() {
+                Ok(t) => t.and_then(|t| u16::try_from(t).ok()),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(EXIT_BAD_INPUT);
+                }
+            };
             // Cases that run side by side share the cores: one thread each unless told.
             let side_by_side = jobs.unwrap_or_else(cores) > 1;
-            if let Some(t) = threads.or(side_by_side.then_some(1)) {
+            if let Some(t) = threads.or(env).or(side_by_side.then_some(1)) {
                 extra.extend(["--threads".to_string(), t.to_string()]);
             }
             match single("plan", &cases, Some("plan"), json, jobs, &extra) {
