@@ -375,7 +375,7 @@ impl Nlp for MinimaxProblem {
             let (path, ks, skip, objective) = (&self.path, &self.ks, &self.skip, self.objective);
             let (a, shapes, work) = (&mut self.a, &mut self.shapes, &mut self.work);
             self.workers
-                .for_each_chunk3(a, shapes, work, |j0, a, shapes, work| {
+                .for_each_chunk3(0, a, shapes, work, |j0, a, shapes, work| {
                     if !light {
                         for (i, ai) in a.iter_mut().enumerate() {
                             path.shape_at(z, ks[j0 + i], ai);
@@ -443,7 +443,7 @@ impl Nlp for MinimaxProblem {
             (self.travel_weight, self.track_weight, self.mean_weight);
         let travel = travel_weight != 0.0;
         let end = model.mesh.boundaries.len() - 1;
-        self.workers.for_each_chunk(&mut self.work, |j0, work| {
+        self.workers.for_each_chunk(1, &mut self.work, |j0, work| {
             for (i, w) in work.iter_mut().enumerate() {
                 let j = j0 + i;
                 let wj = weights[j] + mean_weight / nk;
@@ -514,7 +514,7 @@ impl Nlp for MinimaxProblem {
         let (swept, targets, objective) = (&self.swept, &self.targets, self.objective);
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
-        self.workers.for_each_chunk(&mut self.work, |j0, work| {
+        self.workers.for_each_chunk(2, &mut self.work, |j0, work| {
             for (i, w) in work.iter_mut().enumerate() {
                 let j = j0 + i;
                 let k = ks[j];

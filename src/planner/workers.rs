@@ -5,7 +5,9 @@
 //! sample order: a plan is the same bit for bit on any number of threads. A planar
 //! evaluation takes a tenth of a millisecond, about what waking a sleeping thread costs, so an
 //! idle helper keeps looking for work for a while before it sleeps, and each thread takes the
-//! same share of the samples at every call (their data stays in its core's cache).
+//! same share of the samples at every call (their data stays in its core's cache). Each kind of
+//! job runs shared or on the calling thread alone by what it has lately cost each way: small
+//! jobs (a rod with few nodes, most samples left out) go faster alone.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
 use std::sync::{Arc, Mutex};
@@ -18,6 +20,55 @@ pub const CHUNK: usize = 4;
 /// than the optimiser's own work between two evaluations, so that a helper is awake when the
 /// next one starts (waking a sleeping thread costs about as much as a planar evaluation).
 const SPIN: Duration = Duration::from_micros(100);
+
+/// Kinds of job a caller tells apart ([`Workers::for_each_chunk3`]'s `kind`).
+pub const KINDS: usize = 4;
+
+/// Whether a kind of job runs shared or on the calling thread alone, by what each has cost
+/// lately. Sharing costs a hand-over, and a helper that looks for work slows a calling thread
+/// that shares its core's resources; where a job is small (a rod with few nodes, one obstacle,
+/// most samples left out) the calling thread alone is faster. The choice changes only who runs
+/// a chunk, never what it computes.
+#[derive(Clone, Copy, Debug, Default)]
+struct Choice {
+    calls: u64,
+    /// Moving averages of a call's wall time (ns): alone, shared.
+    alone: f64,
+    shared: f64,
+}
+
+impl Choice {
+    /// Calls of each way tried first, and how often the way not chosen is tried again.
+    const PROBE: u64 = 4;
+    const REPROBE: u64 = 32;
+
+    fn shared_next(&self) -> bool {
+        let c = self.calls;
+        if c < 2 * Self::PROBE {
+            return c >= Self::PROBE;
+        }
+        let better = self.shared < self.alone;
+        if c.is_multiple_of(Self::REPROBE) {
+            !better
+        } else {
+            better
+        }
+    }
+
+    fn record(&mut self, shared: bool, ns: f64) {
+        let avg = if shared {
+            &mut self.shared
+        } else {
+            &mut self.alone
+        };
+        *avg = if self.calls < 2 * Self::PROBE && *avg == 0.0 {
+            ns
+        } else {
+            0.75 * *avg + 0.25 * ns
+        };
+        self.calls += 1;
+    }
+}
 
 /// Where chunks of work run: on the calling thread alone, or also on helper threads that live
 /// as long as the planner.
@@ -55,8 +106,9 @@ struct Shared {
 }
 
 struct Team {
-    /// Held while a job runs: one job at a time (a second caller runs its chunks alone).
-    busy: Mutex<()>,
+    /// Held while a job runs: one job at a time (a second caller runs its chunks alone); it
+    /// holds what each kind of job has cost alone and shared ([`Choice`]).
+    busy: Mutex<[Choice; KINDS]>,
     shared: Arc<Shared>,
     helpers: Vec<(std::thread::JoinHandle<()>, Arc<AtomicBool>)>,
 }
@@ -141,7 +193,7 @@ impl Workers {
         }
         Workers {
             team: Some(Arc::new(Team {
-                busy: Mutex::new(()),
+                busy: Mutex::new([Choice::default(); KINDS]),
                 shared,
                 helpers,
             })),
@@ -192,15 +244,23 @@ impl Workers {
 
     /// Calls `f(j0, a_chunk)` on every chunk of [`CHUNK`] items of `a`, `j0` being the chunk's
     /// first index; the calling thread takes part and returns when every chunk is done.
-    pub fn for_each_chunk<A: Send>(&self, a: &mut [A], f: impl Fn(usize, &mut [A]) + Sync) {
+    pub fn for_each_chunk<A: Send>(
+        &self,
+        kind: usize,
+        a: &mut [A],
+        f: impl Fn(usize, &mut [A]) + Sync,
+    ) {
         let mut b = vec![(); a.len()];
         let mut c = vec![(); a.len()];
-        self.for_each_chunk3(a, &mut b, &mut c, |j0, a, _, _| f(j0, a));
+        self.for_each_chunk3(kind, a, &mut b, &mut c, |j0, a, _, _| f(j0, a));
     }
 
     /// [`Workers::for_each_chunk`] on the same chunks of three slices of the same length.
+    /// `kind` (below [`KINDS`]) names the job, whose calls run shared or alone by what they
+    /// have cost each way.
     pub fn for_each_chunk3<A: Send, B: Send, C: Send>(
         &self,
+        kind: usize,
         a: &mut [A],
         b: &mut [B],
         c: &mut [C],
@@ -210,11 +270,17 @@ impl Workers {
         // The team runs one job at a time: a clone of these workers used on another thread
         // meanwhile runs its chunks alone.
         let team = self.team.as_ref().filter(|_| a.len() > CHUNK);
-        let busy = team.and_then(|t| t.busy.try_lock().ok());
-        let (Some(team), Some(_busy)) = (team, busy) else {
+        let mut busy = team.and_then(|t| t.busy.try_lock().ok());
+        let choice = busy.as_mut().map(|b| &mut b[kind.min(KINDS - 1)]);
+        let shared = choice.as_ref().is_some_and(|c| c.shared_next());
+        let t0 = Instant::now();
+        let (Some(team), true) = (team, shared) else {
             let chunks = a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK));
             for (i, ((x, y), z)) in chunks.zip(c.chunks_mut(CHUNK)).enumerate() {
                 f(i * CHUNK, x, y, z);
+            }
+            if let Some(choice) = choice {
+                choice.record(false, t0.elapsed().as_nanos() as f64);
             }
             return;
         };
@@ -239,6 +305,9 @@ impl Workers {
             }
         };
         self.run(team, &work);
+        if let Some(choice) = choice {
+            choice.record(true, t0.elapsed().as_nanos() as f64);
+        }
     }
 }
 
@@ -254,7 +323,7 @@ mod tests {
                 let mut a: Vec<usize> = vec![0; n];
                 let mut b: Vec<usize> = vec![0; n];
                 let mut c: Vec<usize> = vec![0; n];
-                w.for_each_chunk3(&mut a, &mut b, &mut c, |j0, x, y, z| {
+                w.for_each_chunk3(0, &mut a, &mut b, &mut c, |j0, x, y, z| {
                     for (i, u) in x.iter_mut().enumerate() {
                         *u += j0 + i;
                     }
@@ -273,7 +342,7 @@ mod tests {
         for bad in [0, 40] {
             let mut a = vec![0usize; 41];
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                w.for_each_chunk(&mut a, |j0, x| {
+                w.for_each_chunk(0, &mut a, |j0, x| {
                     if (j0..j0 + x.len()).contains(&bad) {
                         panic!("chunk with {bad}");
                     }
@@ -283,7 +352,7 @@ mod tests {
             assert!(r.is_err(), "the panic at sample {bad} is lost");
         }
         let mut a = vec![0usize; 41];
-        w.for_each_chunk(&mut a, |_, x| x.iter_mut().for_each(|v| *v = 1));
+        w.for_each_chunk(0, &mut a, |_, x| x.iter_mut().for_each(|v| *v = 1));
         assert!(a.iter().all(|&v| v == 1));
     }
 
@@ -296,7 +365,7 @@ mod tests {
                 sc.spawn(move || {
                     for _ in 0..200 {
                         let mut a = vec![0usize; 41];
-                        w.for_each_chunk(&mut a, |j0, x| {
+                        w.for_each_chunk(0, &mut a, |j0, x| {
                             for (i, v) in x.iter_mut().enumerate() {
                                 *v = t + j0 + i;
                             }
@@ -306,5 +375,28 @@ mod tests {
                 });
             }
         });
+    }
+
+    #[test]
+    fn a_kind_of_job_runs_the_way_that_has_cost_less_and_tries_the_other_now_and_then() {
+        for (alone, shared) in [(100.0, 60.0), (50.0, 80.0)] {
+            let mut c = Choice::default();
+            let mut ways = Vec::new();
+            for _ in 0..200 {
+                let s = c.shared_next();
+                ways.push(s);
+                c.record(s, if s { shared } else { alone });
+            }
+            let p = Choice::PROBE as usize;
+            assert!(ways[..p].iter().all(|&s| !s) && ways[p..2 * p].iter().all(|&s| s));
+            let cheaper = shared < alone;
+            let other = ways[2 * p..].iter().filter(|&&s| s != cheaper).count();
+            assert_eq!(
+                other,
+                (2 * p..200)
+                    .filter(|i| (*i as u64).is_multiple_of(Choice::REPROBE))
+                    .count()
+            );
+        }
     }
 }
