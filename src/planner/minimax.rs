@@ -65,6 +65,11 @@ pub struct MinimaxProblem {
     workers: Workers,
 }
 
+/// The kinds of job [`Workers`] runs for the problem (each runs shared or alone by its cost).
+const JOB_VALUES: usize = 0;
+const JOB_GRADIENT: usize = 1;
+const JOB_HESSIAN: usize = 2;
+
 /// One sample's results and scratch ([`MinimaxProblem`] evaluates the samples on any number of
 /// threads, each into its own slots, and sums them afterwards in sample order).
 #[derive(Clone, Debug)]
@@ -351,7 +356,9 @@ impl Nlp for MinimaxProblem {
             && self.swept.is_none()
             && self.travel_weight == 0.0
             && self.skip.is_some();
-        // The samples' coefficients, which shapes stay left out, then the other shapes.
+        // Which shapes stay left out (for which the samples' coefficients are needed first),
+        // then, sample by sample, the coefficients (unless done here), shapes, energies and
+        // rows.
         let mut i = 0;
         for (j, &k) in self.ks.iter().enumerate() {
             if light {
@@ -375,7 +382,7 @@ impl Nlp for MinimaxProblem {
             let (path, ks, skip, objective) = (&self.path, &self.ks, &self.skip, self.objective);
             let (a, shapes, work) = (&mut self.a, &mut self.shapes, &mut self.work);
             self.workers
-                .for_each_chunk3(0, a, shapes, work, |j0, a, shapes, work| {
+                .for_each_chunk3(JOB_VALUES, a, shapes, work, |j0, a, shapes, work| {
                     if !light {
                         for (i, ai) in a.iter_mut().enumerate() {
                             path.shape_at(z, ks[j0 + i], ai);
@@ -443,45 +450,46 @@ impl Nlp for MinimaxProblem {
             (self.travel_weight, self.track_weight, self.mean_weight);
         let travel = travel_weight != 0.0;
         let end = model.mesh.boundaries.len() - 1;
-        self.workers.for_each_chunk(1, &mut self.work, |j0, work| {
-            for (i, w) in work.iter_mut().enumerate() {
-                let j = j0 + i;
-                let wj = weights[j] + mean_weight / nk;
-                for (ga, gu) in w.ga.iter_mut().zip(&w.gu) {
-                    *ga = wj * gu;
-                }
-                let Some(ii) = w.interior else { continue };
-                let row = ii * per;
-                w.y.copy_from_slice(&y[row..row + per]);
-                w.adj.clear();
-                let swept_any = swept.as_ref().is_some_and(|sw| {
-                    let ys = &y[n_sample_rows..];
-                    sw.add_chord_cotangents(ii, ys, &interior_shapes, &mut w.adj);
-                    sw.add_sample_weights(ii, ys, offsets, &mut w.y)
-                });
-                if tracked || travel || swept_any || w.y.iter().any(|v| *v != 0.0) {
-                    for (b, blk) in blocks.iter().enumerate() {
-                        let wb = &w.y[offsets[b]..offsets[b + 1]];
-                        if wb.iter().any(|v| *v != 0.0) {
-                            blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
+        self.workers
+            .for_each_chunk(JOB_GRADIENT, &mut self.work, |j0, work| {
+                for (i, w) in work.iter_mut().enumerate() {
+                    let j = j0 + i;
+                    let wj = weights[j] + mean_weight / nk;
+                    for (ga, gu) in w.ga.iter_mut().zip(&w.gu) {
+                        *ga = wj * gu;
+                    }
+                    let Some(ii) = w.interior else { continue };
+                    let row = ii * per;
+                    w.y.copy_from_slice(&y[row..row + per]);
+                    w.adj.clear();
+                    let swept_any = swept.as_ref().is_some_and(|sw| {
+                        let ys = &y[n_sample_rows..];
+                        sw.add_chord_cotangents(ii, ys, &interior_shapes, &mut w.adj);
+                        sw.add_sample_weights(ii, ys, offsets, &mut w.y)
+                    });
+                    if tracked || travel || swept_any || w.y.iter().any(|v| *v != 0.0) {
+                        for (b, blk) in blocks.iter().enumerate() {
+                            let wb = &w.y[offsets[b]..offsets[b + 1]];
+                            if wb.iter().any(|v| *v != 0.0) {
+                                blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
+                            }
                         }
-                    }
-                    if let (true, Some(t)) = (tracked, targets) {
-                        let tj = &t[j];
-                        let wt = track_weight / tj.len() as f64;
-                        for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
-                            w.adj
-                                .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                        if let (true, Some(t)) = (tracked, targets) {
+                            let tj = &t[j];
+                            let wt = track_weight / tj.len() as f64;
+                            for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
+                                w.adj
+                                    .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                            }
                         }
+                        if travel {
+                            let d = travel_cotangent(travel_weight, ks, shapes, end, j);
+                            w.adj.add_pos(end, 1.0, d);
+                        }
+                        w.adj.finish(model, &shapes[j], &mut w.ga);
                     }
-                    if travel {
-                        let d = travel_cotangent(travel_weight, ks, shapes, end, j);
-                        w.adj.add_pos(end, 1.0, d);
-                    }
-                    w.adj.finish(model, &shapes[j], &mut w.ga);
                 }
-            }
-        });
+            });
         for (w, &k) in self.work.iter().zip(&self.ks) {
             if w.interior.is_some() {
                 self.path.add_chain(&w.ga, k, g);
@@ -514,50 +522,51 @@ impl Nlp for MinimaxProblem {
         let (swept, targets, objective) = (&self.swept, &self.targets, self.objective);
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
-        self.workers.for_each_chunk(2, &mut self.work, |j0, work| {
-            for (i, w) in work.iter_mut().enumerate() {
-                let j = j0 + i;
-                let k = ks[j];
-                w.gz.clear();
-                w.gz.resize(nv, 0.0);
-                let Some(ii) = w.interior else { continue };
-                let row = ii * per;
-                path.add_chain(&w.gu, k, &mut w.gz);
-                let ha = &mut w.ha;
-                ha.clear();
-                ha.resize(n * n, 0.0);
-                let wj = weights[j] + mean_weight / nk;
-                let shape = &shapes[j];
-                model.add_energy_hessian(shape, objective, wj, ha);
-                let aj = &a[j];
-                w.y.copy_from_slice(&y[row..row + per]);
-                // The swept rows' share of this sample's obstacle rows, and their chord terms.
-                if let Some(sw) = swept {
-                    sw.add_sample_weights(ii, &y[ns..], offsets, &mut w.y);
-                }
-                add_weighted_curvature(blocks, offsets, model, aj, shape, &w.y, &mut w.adj, ha);
-                if let Some(sw) = swept {
-                    sw.add_chord_cotangents(ii, &y[ns..], &interior_shapes, &mut w.adj);
-                }
-                if let (true, Some(t)) = (tracked, targets) {
-                    let tj = &t[j];
-                    let wt = track_weight / tj.len() as f64;
-                    for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
-                        w.adj
-                            .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+        self.workers
+            .for_each_chunk(JOB_HESSIAN, &mut self.work, |j0, work| {
+                for (i, w) in work.iter_mut().enumerate() {
+                    let j = j0 + i;
+                    let k = ks[j];
+                    w.gz.clear();
+                    w.gz.resize(nv, 0.0);
+                    let Some(ii) = w.interior else { continue };
+                    let row = ii * per;
+                    path.add_chain(&w.gu, k, &mut w.gz);
+                    let ha = &mut w.ha;
+                    ha.clear();
+                    ha.resize(n * n, 0.0);
+                    let wj = weights[j] + mean_weight / nk;
+                    let shape = &shapes[j];
+                    model.add_energy_hessian(shape, objective, wj, ha);
+                    let aj = &a[j];
+                    w.y.copy_from_slice(&y[row..row + per]);
+                    // The swept rows' share of this sample's obstacle rows, and their chord terms.
+                    if let Some(sw) = swept {
+                        sw.add_sample_weights(ii, &y[ns..], offsets, &mut w.y);
                     }
-                    model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
+                    add_weighted_curvature(blocks, offsets, model, aj, shape, &w.y, &mut w.adj, ha);
+                    if let Some(sw) = swept {
+                        sw.add_chord_cotangents(ii, &y[ns..], &interior_shapes, &mut w.adj);
+                    }
+                    if let (true, Some(t)) = (tracked, targets) {
+                        let tj = &t[j];
+                        let wt = track_weight / tj.len() as f64;
+                        for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
+                            w.adj
+                                .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                        }
+                        model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
+                    }
+                    if travel_weight != 0.0 {
+                        let end = model.mesh.boundaries.len() - 1;
+                        let d = travel_cotangent(travel_weight, ks, shapes, end, j);
+                        w.adj.add_pos(end, 1.0, d);
+                    }
+                    w.adj.finish_hessian(model, shape, ha);
+                    let sj = &s[row..row + per];
+                    add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut w.adj, ha);
                 }
-                if travel_weight != 0.0 {
-                    let end = model.mesh.boundaries.len() - 1;
-                    let d = travel_cotangent(travel_weight, ks, shapes, end, j);
-                    w.adj.add_pos(end, 1.0, d);
-                }
-                w.adj.finish_hessian(model, shape, ha);
-                let sj = &s[row..row + per];
-                add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut w.adj, ha);
-            }
-        });
+            });
         for (j, w) in self.work.iter().enumerate() {
             if w.interior.is_some() {
                 for (b, v) in gbar.iter_mut().zip(&w.gz) {
