@@ -293,10 +293,9 @@ impl Workers {
             .collect();
         // Thread `t` of `n` takes its own share of the chunks first (the same share at every
         // call, so that a sample's data stays in one core's cache), then whatever is left.
-        let n = self.threads();
-        let share = pieces.len().div_ceil(n);
+        let (n, len) = (self.threads(), pieces.len());
         let work = |t: usize| {
-            let own = (t * share).min(pieces.len())..((t + 1) * share).min(pieces.len());
+            let own = (t * len / n).min(len)..((t + 1) * len / n).min(len);
             for i in own.chain(0..pieces.len()) {
                 let taken = pieces[i].lock().map(|mut p| p.take());
                 if let Ok(Some(((x, y), z))) = taken {
