@@ -89,9 +89,6 @@ impl Model {
         grad: Option<&mut [f64]>,
     ) -> EnergyTerms {
         let lay = &self.layout;
-        let nb = self.nb();
-        let op = lay.offset(Field::Phi);
-        let ops = lay.offset(Field::Psi);
         let oe = lay.offset(Field::Eps);
         let spatial = lay.spatial;
         let mut t = EnergyTerms::default();
@@ -103,6 +100,7 @@ impl Model {
         let up = self.up();
         // The node sums below, unless the quadratic form has already given them.
         let nodes = if quadratic { 0 } else { self.nodes() };
+        let mut factors: Vec<[f64; 6]> = Vec::with_capacity(if grad.is_some() { nodes } else { 0 });
         for q in 0..nodes {
             let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
             let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
@@ -134,34 +132,21 @@ impl Model {
                 }
             };
             t.gravitational += grav;
-            let Some(g) = grad.as_deref_mut() else {
+            if grad.is_none() {
                 continue;
-            };
-            let (e, de) = (self.e_at(q), self.de_at(q));
-            // d/dθ (value) and d/dθ' terms
+            }
+            // The node's factors of the basis rows in the gradient (d/dθ, d/dθ', d/dφ, d/dφ',
+            // d/dψ', d/dε); `add_node_sums` adds them up over the nodes.
             let mut g_th = grav_th;
             let g_dth = wf * dth;
             if spatial {
                 g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
             }
-            for i in 0..nb {
-                g[i] += g_th * e[i] + g_dth * de[i];
-            }
-            if let (Some(op), Some(ops)) = (op, ops) {
-                let g_ph = grav_ph;
-                let g_dph = wf * dph * st * st + wt * omega * ct;
-                let g_dps = wt * omega;
-                for i in 0..nb {
-                    g[op + i] += g_ph * e[i] + g_dph * de[i];
-                    g[ops + i] += g_dps * de[i];
-                }
-            }
-            if let Some(oe) = oe {
-                let g_e = we * eps + grav_e;
-                for i in 0..nb {
-                    g[oe + i] += g_e * e[i];
-                }
-            }
+            let g_dph = wf * dph * st * st + wt * omega * ct;
+            factors.push([g_th, g_dth, grav_ph, g_dph, wt * omega, we * eps + grav_e]);
+        }
+        if let Some(g) = grad.as_deref_mut() {
+            self.add_node_sums(&factors, g);
         }
         let base = self.base_position(a);
         t.gravitational += self.gravity_total * base[0];
@@ -213,6 +198,82 @@ impl Model {
         }
     }
 
+    /// Adds the node sums of the energy gradient to `g`: for each basis function `i`,
+    /// `Σ_q (f_θ e_i + f_θ' e'_i)` to θ's coefficient, `Σ_q (f_φ e_i + f_φ' e'_i)` to φ's,
+    /// `Σ_q f_ψ' e'_i` to ψ's and `Σ_q f_ε e_i` to ε's, with the node factors `f` of
+    /// `factors` (in `energy_body`'s order). Four basis functions at a time, each sum kept in
+    /// a register across the nodes, and each added in node order exactly as one node at a
+    /// time would (the same result bit for bit).
+    #[inline(always)]
+    fn add_node_sums(&self, factors: &[[f64; 6]], g: &mut [f64]) {
+        let lay = &self.layout;
+        let nb = self.nb();
+        let (op, ops, oe) = (
+            lay.offset(Field::Phi),
+            lay.offset(Field::Psi),
+            lay.offset(Field::Eps),
+        );
+        let angles = op.zip(ops);
+        let mut i0 = 0;
+        while i0 < nb {
+            let w = (nb - i0).min(4);
+            let mut th = [0.0; 4];
+            let mut ph = [0.0; 4];
+            let mut ps = [0.0; 4];
+            let mut ep = [0.0; 4];
+            for l in 0..w {
+                th[l] = g[i0 + l];
+                if let Some((op, ops)) = angles {
+                    ph[l] = g[op + i0 + l];
+                    ps[l] = g[ops + i0 + l];
+                }
+                if let Some(oe) = oe {
+                    ep[l] = g[oe + i0 + l];
+                }
+            }
+            let rows = self.e.chunks_exact(nb).zip(self.de.chunks_exact(nb));
+            if w == 4 {
+                for (f, (e, de)) in factors.iter().zip(rows) {
+                    let ev: &[f64; 4] = e[i0..i0 + 4].try_into().expect("four");
+                    let dv: &[f64; 4] = de[i0..i0 + 4].try_into().expect("four");
+                    node_terms(
+                        f,
+                        ev,
+                        dv,
+                        angles.is_some(),
+                        oe.is_some(),
+                        [&mut th, &mut ph, &mut ps, &mut ep],
+                    );
+                }
+            } else {
+                for (f, (e, de)) in factors.iter().zip(rows) {
+                    for l in 0..w {
+                        let (ev, dv) = (e[i0 + l], de[i0 + l]);
+                        th[l] += f[0] * ev + f[1] * dv;
+                        if angles.is_some() {
+                            ph[l] += f[2] * ev + f[3] * dv;
+                            ps[l] += f[4] * dv;
+                        }
+                        if oe.is_some() {
+                            ep[l] += f[5] * ev;
+                        }
+                    }
+                }
+            }
+            for l in 0..w {
+                g[i0 + l] = th[l];
+                if let Some((op, ops)) = angles {
+                    g[op + i0 + l] = ph[l];
+                    g[ops + i0 + l] = ps[l];
+                }
+                if let Some(oe) = oe {
+                    g[oe + i0 + l] = ep[l];
+                }
+            }
+            i0 += w;
+        }
+    }
+
     /// Objective value and gradient (overwritten) at `a`; convenience for tests and solvers.
     pub fn objective_and_gradient(
         &self,
@@ -225,6 +286,32 @@ impl Model {
         grad.iter_mut().for_each(|g| *g = 0.0);
         self.energy(a, shape, objective, Some(grad))
             .value(objective)
+    }
+}
+
+/// One node's terms of [`Model::add_node_sums`] for four basis functions at once.
+#[inline(always)]
+fn node_terms(
+    f: &[f64; 6],
+    e: &[f64; 4],
+    de: &[f64; 4],
+    angles: bool,
+    extensible: bool,
+    [th, ph, ps, ep]: [&mut [f64; 4]; 4],
+) {
+    for l in 0..4 {
+        th[l] += f[0] * e[l] + f[1] * de[l];
+    }
+    if angles {
+        for l in 0..4 {
+            ph[l] += f[2] * e[l] + f[3] * de[l];
+            ps[l] += f[4] * de[l];
+        }
+    }
+    if extensible {
+        for l in 0..4 {
+            ep[l] += f[5] * e[l];
+        }
     }
 }
 
