@@ -46,6 +46,14 @@ impl McapWriter<BufWriter<File>> {
     }
 }
 
+/// What a channel is created with: its schema and its messages' encoding.
+struct ChannelSpec {
+    schema_name: String,
+    schema_encoding: String,
+    schema: Vec<u8>,
+    message_encoding: String,
+}
+
 impl<W: Write + Seek> McapWriter<W> {
     /// Starts a log on `w`.
     pub fn new(w: W) -> Result<Self, LogError> {
@@ -73,26 +81,32 @@ impl<W: Write + Seek> McapWriter<W> {
             .ok_or_else(|| std::io::Error::other("log already finished").into())
     }
 
+    /// The id of `topic`'s channel, created (with its schema, once per schema name) the first
+    /// time from what `describe` says.
     fn channel(
         &mut self,
         topic: &str,
-        schema: (&str, &str, &[u8]),
-        message_encoding: &str,
+        describe: impl FnOnce() -> ChannelSpec,
     ) -> Result<u16, LogError> {
         if let Some(&id) = self.channels.get(topic) {
             return Ok(id);
         }
-        let sid = match self.schemas.get(schema.0) {
+        let spec = describe();
+        let sid = match self.schemas.get(&spec.schema_name) {
             Some(&s) => s,
             None => {
-                let s = self.writer()?.add_schema(schema.0, schema.1, schema.2)?;
-                self.schemas.insert(schema.0.to_string(), s);
+                let s = self.writer()?.add_schema(
+                    &spec.schema_name,
+                    &spec.schema_encoding,
+                    &spec.schema,
+                )?;
+                self.schemas.insert(spec.schema_name, s);
                 s
             }
         };
-        let id = self
-            .writer()?
-            .add_channel(sid, topic, message_encoding, &BTreeMap::new())?;
+        let id =
+            self.writer()?
+                .add_channel(sid, topic, &spec.message_encoding, &BTreeMap::new())?;
         self.channels.insert(topic.to_string(), id);
         Ok(id)
     }
@@ -120,12 +134,15 @@ impl<W: Write + Seek> McapWriter<W> {
         log_time: u64,
         msg: &T,
     ) -> Result<(), LogError> {
-        let schema = T::get_schema().expect("Foxglove schemas carry a descriptor");
-        let id = self.channel(
-            topic,
-            (&schema.name, &schema.encoding, &schema.data),
-            &T::get_message_encoding(),
-        )?;
+        let id = self.channel(topic, || {
+            let schema = T::get_schema().expect("Foxglove schemas carry a descriptor");
+            ChannelSpec {
+                schema_name: schema.name,
+                schema_encoding: schema.encoding,
+                schema: schema.data.into_owned(),
+                message_encoding: T::get_message_encoding(),
+            }
+        })?;
         self.buf.clear();
         msg.encode(&mut self.buf)
             .map_err(|e| std::io::Error::other(format!("encoding {topic}: {e:?}")))?;
@@ -141,14 +158,12 @@ impl<W: Write + Seek> McapWriter<W> {
         log_time: u64,
         msg: &serde_json::Value,
     ) -> Result<(), LogError> {
-        // The schema is written once, with the topic's channel.
-        let id = match self.channels.get(topic) {
-            Some(&id) => id,
-            None => {
-                let schema_bytes = serde_json::to_vec(schema).expect("schema serialises");
-                self.channel(topic, (name, "jsonschema", &schema_bytes), "json")?
-            }
-        };
+        let id = self.channel(topic, || ChannelSpec {
+            schema_name: name.to_string(),
+            schema_encoding: "jsonschema".to_string(),
+            schema: serde_json::to_vec(schema).expect("schema serialises"),
+            message_encoding: "json".to_string(),
+        })?;
         self.buf.clear();
         // A member without a value is left out, as the schemas say (see `json_schemas`).
         serde_json::to_writer(&mut self.buf, &super::json_schemas::WithoutNulls(msg))
