@@ -246,18 +246,21 @@ impl Model {
                     );
                 }
             } else {
+                // The last basis functions, fewer than four: the lanes past them add zeros
+                // and are not written back.
                 for (f, (e, de)) in factors.iter().zip(rows) {
+                    let (mut ev, mut dv) = ([0.0; 4], [0.0; 4]);
                     for l in 0..w {
-                        let (ev, dv) = (e[i0 + l], de[i0 + l]);
-                        th[l] += f[0] * ev + f[1] * dv;
-                        if angles.is_some() {
-                            ph[l] += f[2] * ev + f[3] * dv;
-                            ps[l] += f[4] * dv;
-                        }
-                        if oe.is_some() {
-                            ep[l] += f[5] * ev;
-                        }
+                        (ev[l], dv[l]) = (e[i0 + l], de[i0 + l]);
                     }
+                    node_terms(
+                        f,
+                        &ev,
+                        &dv,
+                        angles.is_some(),
+                        oe.is_some(),
+                        [&mut th, &mut ph, &mut ps, &mut ep],
+                    );
                 }
             }
             for l in 0..w {
