@@ -16,6 +16,7 @@ pub mod result;
 pub mod settings;
 mod start;
 mod starts;
+mod straight_path;
 pub mod swept;
 mod tracking;
 pub mod trajectory;
@@ -831,7 +832,43 @@ impl Planner {
         (e, clearance(&self.base, &shape.positions))
     }
 
-    /// Optimises, verifies and replays the plan.
+    /// Runs the starts, replaying the best plan so far after each group (its shapes kept, to
+    /// be logged if it is chosen); returns every start's plan, the chosen one (the executable
+    /// one if any, else the best by class and `U_max`) and its judgement.
+    fn optimise_and_judge(
+        &self,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> (Vec<StartPlan>, usize, Judged) {
+        // The starts stop at the first executable plan, or as soon as a replay leaves the start
+        // shape at k = 0, which no path can change.
+        let mut judged: Vec<(usize, Judged)> = Vec::new();
+        let mut judge = |runs: &[StartPlan], observer: &mut dyn PlanObserver| -> bool {
+            let best = self.best_of(runs);
+            if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
+                return j.executable || !j.replay.start_held();
+            }
+            let j = self.judge(&runs[best], fine, observer);
+            let stop = j.executable || !j.replay.start_held();
+            judged.push((best, j));
+            stop
+        };
+        let runs = self.run_starts(fine, observer, &mut judge);
+        let best = judged
+            .iter()
+            .find(|(_, j)| j.executable)
+            .map_or_else(|| self.best_of(&runs), |(i, _)| *i);
+        let judged = match judged.into_iter().find(|(i, _)| *i == best) {
+            Some((_, j)) => j,
+            None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
+            None => self.judge(&runs[best], fine, observer),
+        };
+        (runs, best, judged)
+    }
+
+    /// Optimises, verifies and replays the plan: the straight-line path when it already
+    /// attains the lower bound on `U_max` and executes as it stands
+    /// ([`PlanSettings::straight_path_first`]), else the best of the starts.
     pub fn run(&self, observer: &mut dyn PlanObserver) -> PlanResult {
         let model = &self.base.model;
         observer.begin(model);
@@ -886,40 +923,33 @@ impl Planner {
         observer.phase("optimise");
         self.poll(observer);
         let tol = self.collision_tolerance();
-        // The best plan so far is replayed (its shapes kept, to be logged if it is chosen)
-        // after each group of starts; the starts stop at the first executable one, or as soon
-        // as a replay leaves the start shape at k = 0, which no path can change.
-        let mut judged: Vec<(usize, Judged)> = Vec::new();
-        let mut judge = |runs: &[StartPlan], observer: &mut dyn PlanObserver| -> bool {
-            let best = self.best_of(runs);
-            if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
-                return j.executable || !j.replay.start_held();
+        // The straight path when it already attains the lower bound and executes as it
+        // stands; else the starts.
+        let (runs, best, mut judged) = match self.straight_path_plan(&straight, observer) {
+            Some(j) => (Vec::new(), None, j),
+            None => {
+                let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
+                (runs, Some(best), judged)
             }
-            let j = self.judge(&runs[best], &fine, observer);
-            let stop = j.executable || !j.replay.start_held();
-            judged.push((best, j));
-            stop
         };
-        let runs = self.run_starts(&fine, observer, &mut judge);
-        // The plan: the executable one if any, else the best by class and U_max.
-        let best = judged
-            .iter()
-            .find(|(_, j)| j.executable)
-            .map_or_else(|| self.best_of(&runs), |(i, _)| *i);
         observer.phase("select");
-        let path_terms = runs[best].terms;
+        let path_terms = best.map_or(self.settings.path_terms, |b| runs[b].terms);
         let path = self.with_terms(path_terms).path();
+        // The chosen start's plan, or the straight path's (no optimiser run, no samples added).
         let Verified {
             run: chosen,
             verification: ver,
             added,
-        } = runs[best].plan.clone();
-        let chosen = &chosen;
-        let mut judged = match judged.into_iter().find(|(i, _)| *i == best) {
-            Some((_, j)) => j,
-            None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
-            None => self.judge(&runs[best], &fine, observer),
+        } = match best {
+            Some(b) => runs[b].plan.clone(),
+            None => Verified {
+                run: start::StartRun::not_optimised(path.n_vars(), straight.u_max),
+                verification: straight.clone(),
+                added: Vec::new(),
+            },
         };
+        let optimiser = best.map(|_| chosen.status);
+        let chosen = &chosen;
         // Nothing executable: the trajectory of the straight-line path's end, with the
         // equilibria the end poses produce (touching obstacles where the straight shapes cross
         // them), as the plan if they pass.
@@ -993,14 +1023,15 @@ impl Planner {
             PlanStatus::Collision
         } else if workspace.as_ref().is_some_and(|w| !w.within) {
             PlanStatus::OutsideWorkspace
-        } else if chosen.status != AlStatus::Converged {
+        } else if optimiser.is_some_and(|o| o != AlStatus::Converged) {
             PlanStatus::NotConverged
         } else {
             PlanStatus::Planned
         };
         PlanResult {
             status,
-            optimiser: chosen.status,
+            optimiser,
+            straight_path_plan: best.is_none(),
             u_max: ver.u_max,
             k_at_u_max: ver.k_at_u_max,
             sampled_u_max: chosen.sampled_max,
@@ -1034,7 +1065,7 @@ impl Planner {
                     .filter(|r| r.index < self.settings.starts)
                     .count(),
             path_terms,
-            chosen_start: runs[best].index,
+            chosen_start: best.map(|b| runs[b].index),
             path: path.c_vectors(&chosen.z),
             added_samples: added,
             z: chosen.z.clone(),

@@ -10,7 +10,8 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlanStatus {
-    /// The optimiser converged and the verification grid is collision-free.
+    /// The optimiser converged (or the straight-line path attains the lower bound on `U_max`,
+    /// [`PlanResult::straight_path_plan`]) and the verification grid is collision-free.
     Planned,
     /// The verification grid finds a collision (e.g. tunnelling between samples).
     Collision,
@@ -127,8 +128,14 @@ pub struct StartSummary {
 pub struct PlanResult {
     /// Overall status.
     pub status: PlanStatus,
-    /// Optimiser status of the chosen start.
-    pub optimiser: AlStatus,
+    /// Optimiser status of the chosen start (`None` when the plan is the straight-line path,
+    /// taken without optimising: [`PlanResult::straight_path_plan`]).
+    pub optimiser: Option<AlStatus>,
+    /// The plan is the straight-line path `c = 0`, taken before any optimisation because it
+    /// attains the lower bound on every path's `U_max` (the larger end energy), keeps the
+    /// safety margin from the obstacles and coincides with its replay
+    /// ([`super::PlanSettings::straight_path_first`]); `starts` is then empty.
+    pub straight_path_plan: bool,
     /// True `U_max` of the plan on the verification grid (case units).
     pub u_max: f64,
     /// `k` where it occurs.
@@ -157,8 +164,9 @@ pub struct PlanResult {
     /// used.
     pub path_terms: usize,
     /// The start the plan comes from: collision-free first, then feasible on the samples, then
-    /// estimated to coincide, then the lowest verified `U_max`.
-    pub chosen_start: usize,
+    /// estimated to coincide, then the lowest verified `U_max` (`None`: the straight-line
+    /// path, no start ran).
+    pub chosen_start: Option<usize>,
     /// Path vectors `cᵢ` (coefficient space).
     pub path: Vec<Vec<f64>>,
     /// The unknowns `z` of the plan's path, `planner.with_terms(path_terms).path()`.

@@ -91,6 +91,12 @@ pub struct PlanSettings {
     /// Bounds on the controlled end's position along the plan (a robot's reach), in case
     /// units and axes; absent: none.
     pub workspace: Option<Workspace>,
+    /// Before optimising, take the straight-line path `c = 0` as the plan when it already
+    /// attains the lower bound on every path's `U_max` — its largest energy on the
+    /// verification grid is at an end, and every path passes through both ends — keeps the
+    /// safety margin from every obstacle, and coincides with its replay (see
+    /// [`super::Planner::run`]); `false`: always optimise, as in the paper.
+    pub straight_path_first: bool,
 }
 
 /// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
@@ -149,6 +155,7 @@ impl Default for PlanSettings {
             swept_clearance: d_swept(),
             equilibrium_plans: true,
             workspace: None,
+            straight_path_first: true,
         }
     }
 }

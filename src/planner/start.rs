@@ -52,6 +52,25 @@ pub(super) struct StartRun {
     pub(super) equilibrium_deviation: Option<f64>,
 }
 
+impl StartRun {
+    /// The straight-line path `z = 0` (`n` unknowns) as a run that never optimised: no
+    /// evaluations, no violation (its ends are the end shapes and its obstacle clearance is
+    /// checked on the verification grid), `sampled_max` the largest energy of its samples; its
+    /// `status` is not reported (the plan's `optimiser` is `None`).
+    pub(super) fn not_optimised(n: usize, sampled_max: f64) -> StartRun {
+        StartRun {
+            z: vec![0.0; n],
+            status: AlStatus::IterationLimit,
+            violation: 0.0,
+            sampled_max,
+            evaluations: 0,
+            tracking_rounds: 0,
+            tracking_rounds_kept: 0,
+            equilibrium_deviation: None,
+        }
+    }
+}
+
 impl Planner {
     /// The multiplier-method settings of each sharpness stage (the penalty restarts at 1e2).
     pub fn stage_options(&self) -> AlOptions {

@@ -195,9 +195,9 @@ pub(crate) fn run_plan(
         }
         PlanVerdict::NotConverged => {
             eprintln!(
-                "error: {}: the path optimiser did not converge ({:?}, violation {:.2e}){}",
+                "error: {}: the path optimiser did not converge ({}, violation {:.2e}){}",
                 path.display(),
-                result.optimiser,
+                result.optimiser.map_or("not run".into(), |o| o.to_string()),
                 result.violation,
                 equilibria_not_a_plan(&result)
             );
@@ -278,7 +278,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "case {}: {}{} ({}; optimiser {})",
+        "case {}: {}{} ({}; {})",
         r.case,
         r.verdict,
         match r.executed_path {
@@ -288,11 +288,15 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                     .is_some_and(|e| e.trajectory == "straight_path") =>
                 " by the replayed equilibria along the straight-line path's trajectory",
             Some("equilibria") => " by the replayed equilibria along the optimal path's trajectory",
+            Some(_) if p.straight_path_plan => " along the straight-line path",
             Some(_) => " as optimised",
             None => "",
         },
         p.status,
-        p.optimiser
+        match p.optimiser {
+            Some(o) => format!("optimiser {o}"),
+            None => "optimiser not run: the straight-line path attains the lower bound on U_max, the larger end energy".into(),
+        }
     );
     let _ = writeln!(
         o,
@@ -325,7 +329,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             o,
             "  starts: {}{not_run}, chosen {} (path terms {}); verified U_max (sampled; samples' distance to their equilibria) {}",
             p.starts.len(),
-            p.chosen_start,
+            p.chosen_start.map_or("none".into(), |c| c.to_string()),
             p.path_terms,
             p.starts
                 .iter()

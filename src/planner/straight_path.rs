@@ -1,0 +1,74 @@
+//! The straight-line path as the plan, before any optimisation, where it provably cannot be
+//! beaten: every path passes through the start and goal shapes, so no path's `U_max` is below
+//! the larger of their energies. When the straight path `c = 0` peaks at an end on the
+//! verification grid, it attains that bound; when it also keeps the optimiser's safety margin
+//! from every obstacle (and clear of itself, and inside the workspace) and coincides with its
+//! replay by the controlled end, it is an optimal, executable plan, and the path optimiser has
+//! nothing left to win on the paper's objective ([`super::PlanSettings::straight_path_first`]).
+//!
+//! The optimiser's tie-breaks (the mean energy along the path, the gripper's travel) are not
+//! weighed against it; `docs/results.md` compares its gripper travel with the optimised plans'.
+
+use super::observer::{PlanObserver, Recorder};
+use super::verify::Verification;
+use super::{Judged, Planner};
+use crate::constraints::Constraint;
+
+impl Planner {
+    /// Whether the straight path `straight` (its verification) attains the lower bound on
+    /// `U_max` and keeps the optimiser's clearances, so that it is worth replaying as the plan:
+    /// the grid's largest energy is at `k = 0` or `k = 1`, every obstacle stays at least the
+    /// safety margin away, the rod keeps clear of itself, and the case holds no condition the
+    /// straight path could break between its ends (a point held along the rod, or the
+    /// workspace, which the replay checks).
+    pub(super) fn straight_path_attains_bound(&self, straight: &Verification) -> bool {
+        let l = self.base.model.rod.length;
+        let at_end = straight.k_at_u_max == 0.0 || straight.k_at_u_max == 1.0;
+        let clear = straight
+            .min_clearance
+            .is_none_or(|c| c >= self.safety() * l)
+            && straight
+                .self_contact
+                .is_none_or(|(g, _)| g >= -self.collision_tolerance());
+        // Conditions the optimiser holds at its samples besides obstacles and self-contact: a
+        // position along the rod (other than the fixed base) is not linear in the
+        // coefficients, so the straight path need not keep it between its ends.
+        let only_contacts = self.base.constraints.iter().all(|c| match c {
+            Constraint::Position(pc) => pc.boundary == 0,
+            Constraint::RelativePosition(_) => false,
+            Constraint::Orientation(_)
+            | Constraint::Linear(_)
+            | Constraint::Obstacle(_)
+            | Constraint::SelfContact(_) => true,
+        });
+        self.settings.straight_path_first && at_end && clear && only_contacts
+    }
+
+    /// The straight path judged as the plan when it attains the lower bound
+    /// ([`Self::straight_path_attains_bound`]) and coincides with its replay inside the
+    /// workspace; `None` otherwise (the replay's shapes are then dropped, not logged).
+    pub(super) fn straight_path_plan(
+        &self,
+        straight: &Verification,
+        observer: &mut dyn PlanObserver,
+    ) -> Option<Judged> {
+        if !self.straight_path_attains_bound(straight) || self.stopped() {
+            return None;
+        }
+        let t = std::time::Instant::now();
+        let path = self.path();
+        let z = vec![0.0; path.n_vars()];
+        let mut rec = Recorder::new(observer);
+        let replay = self.replay_under(&self.base, &path, &z, &mut rec);
+        let workspace = self.workspace_check(&path, &z);
+        let within = workspace.is_none_or(|w| w.within);
+        (replay.coincide && within && !self.stopped()).then(|| Judged {
+            replay,
+            equilibrium_plan: None,
+            workspace,
+            shapes: rec.into_shapes(),
+            seconds: t.elapsed().as_secs_f64(),
+            executable: true,
+        })
+    }
+}
