@@ -4,7 +4,7 @@
 //! the `plan` section) and evaluating the start shape must never panic; every error names the
 //! file; any case that validates has a finite start energy.
 //!
-//! Runs for `DLO_FUZZ_SECONDS` (default 8 s; `.ci/run` gives it more) in batches of proptest
+//! Runs for `DLO_FUZZ_SECONDS` (default 2 s; `.ci/run` gives it more) in batches of proptest
 //! cases from fixed seeds.
 
 use crate::common;

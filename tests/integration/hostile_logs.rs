@@ -4,7 +4,7 @@
 //! reported as damage; what `recover` writes is always a finished, undamaged log holding no
 //! more messages than the original.
 //!
-//! Runs for `DLO_FUZZ_SECONDS` (the two generated tests share it; default 8 s, `.ci/run` gives more) in batches of proptest
+//! Runs for `DLO_FUZZ_SECONDS` (the two generated tests share it; default 2 s, `.ci/run` gives more) in batches of proptest
 //! cases from fixed seeds, so a failure names the batch that reproduces it.
 
 use crate::common;

@@ -176,14 +176,14 @@ pub fn strip(v: &mut serde_json::Value) {
     }
 }
 
-/// Seconds each generated-input test file runs for: `DLO_FUZZ_SECONDS`, or 8 (`.ci/run` sets
-/// more).
+/// Seconds each generated-input test file runs for: `DLO_FUZZ_SECONDS`, or 2 (a quick pass in
+/// the test command; `.ci/run` runs them again for 60 s each).
 pub fn fuzz_seconds() -> f64 {
     std::env::var("DLO_FUZZ_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())
         .filter(|s: &f64| s.is_finite() && *s >= 0.0)
-        .unwrap_or(8.0)
+        .unwrap_or(2.0)
 }
 
 /// Runs batches of `cases` proptest cases of `test` on `strategy`, each batch from its own fixed
