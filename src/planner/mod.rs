@@ -216,6 +216,7 @@ fn end_shape(
     which: &'static str,
     end: &End,
     held: ([f64; 3], bool),
+    fine: &crate::rod::model::Model,
     opts: &StaticOptions,
 ) -> Result<StaticSolution, PlanSetupError> {
     let seed = end_angles(end)
@@ -271,7 +272,8 @@ fn end_shape(
             }
             (None, None) => problem.initial.clone(),
         };
-        solve_static(&mut pose.problem(base), &a0, opts)
+        let sol = solve_static(&mut pose.problem(base), &a0, opts);
+        on_chords_if_dipping(problem, &pose, sol, fine, opts)
     };
     if sol.status != SolveStatus::Converged {
         let msg = if !end.is_pose() {
@@ -299,6 +301,40 @@ fn end_shape(
         });
     }
     Ok(sol)
+}
+
+/// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
+/// where it dips into an obstacle between them on the verification grid (by more than the
+/// collision tolerance, 1e-6 L) and the same pose solved with the contacts on the chords
+/// between the points converges clear of the obstacles there, that shape: an end resting on an
+/// obstacle is a legal end of a path only when the verification grid finds it clear.
+fn on_chords_if_dipping(
+    problem: &PlanProblem,
+    pose: &EndPose,
+    sol: StaticSolution,
+    fine: &crate::rod::model::Model,
+    opts: &StaticOptions,
+) -> StaticSolution {
+    let tol = 1e-6 * problem.statics.model.rod.length;
+    let depth = |a: &[f64]| {
+        let (worst, _) = verify::shapes_clearance(fine, &problem.obstacles, false, [(0.0, a)]);
+        worst
+            .iter()
+            .map(|w| w.clearance)
+            .fold(f64::INFINITY, f64::min)
+    };
+    if sol.status != SolveStatus::Converged || depth(&sol.a) >= -tol {
+        return sol;
+    }
+    let Some(chords) = equilibrium_plan::on_chords(&problem.statics) else {
+        return sol;
+    };
+    let again = solve_static(&mut pose.problem(&chords), &sol.a, opts);
+    if again.status == SolveStatus::Converged && depth(&again.a) >= -tol {
+        again
+    } else {
+        sol
+    }
 }
 
 /// The optimiser's rows of obstacle `ob`: held at the sample points, `safety` (units of L)
@@ -656,9 +692,11 @@ impl Planner {
         };
         let (mut start_end, mut goal_end) = (problem.start.clone(), problem.goal.clone());
         resolve(&mut start_end, "start", held.0)?;
-        let start = end_shape(&problem, "start", &start_end, held, &static_options)?;
+        // The verification grid, on which an end shape resting on an obstacle must be clear.
+        let fine = fine_model(model, settings.verify_s_samples, 4);
+        let start = end_shape(&problem, "start", &start_end, held, &fine, &static_options)?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
-        let goal = end_shape(&problem, "goal", &goal_end, held, &static_options)?;
+        let goal = end_shape(&problem, "goal", &goal_end, held, &fine, &static_options)?;
         if let Some(w) = &settings.workspace {
             check_workspace(model, w, [("start", &start), ("goal", &goal)])?;
         }

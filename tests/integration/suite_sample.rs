@@ -319,3 +319,63 @@ fn held_on_the_trajectory_clear_of_obstacles(
     }
     assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
 }
+
+/// The suite's planar problem `planar_3_35` (seed 3), planned with the defaults: its start
+/// shape rests on an obstacle. Solved with the contacts at the sample points alone it dips into
+/// the obstacle between them by 5.7e-3 L, and the verification grid called every path from it
+/// a collision; the planner solves that pose again with the contacts on the chords between the
+/// points. Checked independently: the start shape holds the same end pose as the point-contact
+/// solve (1e-9), an obstacle pushes on it, it keeps clear on a grid four times finer in s than
+/// the model's boundary points (−1e-6 L) while the point-contact solve of the same pose is
+/// more than 1e-3 L inside, and the plan is executable, held at the trajectory's poses and
+/// clear of the obstacles.
+#[test]
+fn an_end_resting_on_an_obstacle_is_solved_on_chords_and_plans() {
+    use dlo_planner::case;
+    use dlo_planner::planner::endpoints::EndPose;
+    use dlo_planner::planner::verify::fine_model;
+    use dlo_planner::planner::{Planner, observer::Silent};
+    use dlo_planner::statics::solve_static;
+    let mut rng = Rng(3);
+    let text = (0..=35)
+        .map(|j| planar_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_35.json"))
+        .expect("a generated case");
+    let p = Planner::from_case(&c).expect("start and goal solve");
+    let model = &p.base.model;
+    let l = model.rod.length;
+    let fine = fine_model(model, 4 * 256, 2);
+    let depth = |a: &[f64]| {
+        let mut worst = f64::INFINITY;
+        for x in fine.evaluate(a).positions {
+            for o in &p.obstacles {
+                worst = worst.min(o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius);
+            }
+        }
+        worst
+    };
+    // The same pose solved with the contacts at the points, from the planner's start shape.
+    let end = model.boundary(1.0);
+    let start = model.evaluate(&p.start.a).positions;
+    let held = EndPose::of(model, &p.start.a, &start);
+    let points = solve_static(&mut held.problem(&p.base), &p.start.a, &p.static_options);
+    let xp = model.evaluate(&points.a).positions[end];
+    let x = start[end];
+    assert!(
+        (0..3).all(|i| (x[i] - xp[i]).abs() <= 1e-9),
+        "{x:?} vs {xp:?}"
+    );
+    assert!(depth(&points.a) < -1e-3 * l, "{}", depth(&points.a));
+    assert!(depth(&p.start.a) >= -1e-6 * l, "{}", depth(&p.start.a));
+    let pushed = p
+        .start
+        .reactions
+        .iter()
+        .any(|r| r.constraint.contains("o0") && r.force.iter().any(|f| f.abs() > 1e-9));
+    assert!(pushed, "{:?}", p.start.reactions);
+    let r = p.run(&mut Silent);
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
