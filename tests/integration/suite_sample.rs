@@ -309,15 +309,30 @@ fn held_on_the_trajectory_clear_of_obstacles(
     assert!(d <= r.replay.tolerance, "ends {d:.3e} L from the goal");
     // Clearance on a grid four times finer in s than the model's boundary points.
     let fine = fine_model(model, 4 * (last.positions.len() - 1), 2);
+    let worst = r
+        .replay
+        .steps
+        .iter()
+        .map(|step| clearance_on(p, &fine, &step.a))
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
+}
+
+/// The smallest surface gap (case units) between the obstacles of `p` and the shape of
+/// coefficients `a` at the boundary points of the model `fine`.
+fn clearance_on(
+    p: &dlo_planner::planner::Planner,
+    fine: &dlo_planner::rod::model::Model,
+    a: &[f64],
+) -> f64 {
+    let (l, radius) = (p.base.model.rod.length, p.base.model.rod.radius);
     let mut worst = f64::INFINITY;
-    for step in &r.replay.steps {
-        for x in fine.evaluate(&step.a).positions {
-            for o in &p.obstacles {
-                worst = worst.min(o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius);
-            }
+    for x in fine.evaluate(a).positions {
+        for o in &p.obstacles {
+            worst = worst.min(o.signed_distance_value(x.map(|v| v * l)) - radius);
         }
     }
-    assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
+    worst
 }
 
 /// The suite's planar problem `planar_3_35` (seed 3), planned with the defaults: its start
@@ -326,9 +341,9 @@ fn held_on_the_trajectory_clear_of_obstacles(
 /// a collision; the planner solves that pose again with the contacts on the chords between the
 /// points. Checked independently: the start shape holds the same end pose as the point-contact
 /// solve (1e-9), an obstacle pushes on it, it keeps clear on a grid four times finer in s than
-/// the model's boundary points (−1e-6 L) while the point-contact solve of the same pose is
-/// more than 1e-3 L inside, and the plan is executable, held at the trajectory's poses and
-/// clear of the obstacles.
+/// the verification grid (−1e-6 L) while the point-contact solve of the same pose is more than
+/// 1e-3 L inside there, and the plan is executable, held at the trajectory's poses and clear
+/// of the obstacles.
 #[test]
 fn an_end_resting_on_an_obstacle_is_solved_on_chords_and_plans() {
     use dlo_planner::case;
@@ -346,16 +361,8 @@ fn an_end_resting_on_an_obstacle_is_solved_on_chords_and_plans() {
     let p = Planner::from_case(&c).expect("start and goal solve");
     let model = &p.base.model;
     let l = model.rod.length;
-    let fine = fine_model(model, 4 * 256, 2);
-    let depth = |a: &[f64]| {
-        let mut worst = f64::INFINITY;
-        for x in fine.evaluate(a).positions {
-            for o in &p.obstacles {
-                worst = worst.min(o.signed_distance_value(x.map(|v| v * l)) - model.rod.radius);
-            }
-        }
-        worst
-    };
+    // Four times finer in s than the verification grid.
+    let fine = fine_model(model, 4 * p.settings.verify_s_samples, 2);
     // The same pose solved with the contacts at the points, from the planner's start shape.
     let end = model.boundary(1.0);
     let start = model.evaluate(&p.start.a).positions;
@@ -367,8 +374,12 @@ fn an_end_resting_on_an_obstacle_is_solved_on_chords_and_plans() {
         (0..3).all(|i| (x[i] - xp[i]).abs() <= 1e-9),
         "{x:?} vs {xp:?}"
     );
-    assert!(depth(&points.a) < -1e-3 * l, "{}", depth(&points.a));
-    assert!(depth(&p.start.a) >= -1e-6 * l, "{}", depth(&p.start.a));
+    let (at_points, on_chords) = (
+        clearance_on(&p, &fine, &points.a),
+        clearance_on(&p, &fine, &p.start.a),
+    );
+    assert!(at_points < -1e-3 * l, "{at_points}");
+    assert!(on_chords >= -1e-6 * l, "{on_chords}");
     let pushed = p
         .start
         .reactions
