@@ -45,6 +45,9 @@ pub use result::{PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, 
 use start::Verified;
 use starts::StartPlan;
 
+/// Depth (a fraction of L) below which a verified clearance counts as a collision.
+const COLLISION_TOLERANCE: f64 = 1e-6;
+
 /// Largest margin (a fraction of the coincidence tolerance) by which replayed equilibria that
 /// dip between contact points are held off the obstacles.
 const CONTACT_MARGIN_CAP: f64 = 0.05;
@@ -315,7 +318,7 @@ fn on_chords_if_dipping(
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
 ) -> StaticSolution {
-    let tol = 1e-6 * problem.statics.model.rod.length;
+    let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
     let depth = |a: &[f64]| {
         let (worst, _) = verify::shapes_clearance(fine, &problem.obstacles, false, [(0.0, a)]);
         worst
@@ -741,7 +744,7 @@ impl Planner {
 
     /// Depth below which a verified clearance counts as a collision (1e-6 L).
     pub(super) fn collision_tolerance(&self) -> f64 {
-        1e-6 * self.base.model.rod.length
+        COLLISION_TOLERANCE * self.base.model.rod.length
     }
 
     /// Whether the case enforces self-contact.
