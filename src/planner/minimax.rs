@@ -317,6 +317,33 @@ fn travel_cotangent(w: f64, ks: &[f64], shapes: &[Shape], end: usize, j: usize) 
     std::array::from_fn(|c| w * ((xj[c] - xp[c]) / back - (xn[c] - xj[c]) / ahead))
 }
 
+/// Adds sample `j`'s cotangents on its positions of the tracking term, towards `target` (its
+/// equilibrium's boundary positions, when tracked), and of the travel term to `adj`, with the
+/// weights `(track, travel)`; returns the tracking term's weight per point and its number of
+/// points (for its Gauss–Newton part), `None` without a target.
+fn add_track_travel(
+    adj: &mut Adjoint,
+    shapes: &[Shape],
+    ks: &[f64],
+    j: usize,
+    target: Option<&[[f64; 3]]>,
+    (track_weight, travel_weight): (f64, f64),
+) -> Option<(f64, usize)> {
+    let tracked = target.map(|tj| {
+        let wt = track_weight / tj.len() as f64;
+        for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
+            adj.add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+        }
+        (wt, tj.len())
+    });
+    if travel_weight != 0.0 {
+        let end = shapes[j].positions.len() - 1;
+        let d = travel_cotangent(travel_weight, ks, shapes, end, j);
+        adj.add_pos(end, 1.0, d);
+    }
+    tracked
+}
+
 /// `S_β(u)` and its weights `∂S/∂u_j` (a softmax).
 pub fn smoothed_max(u: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
     let umax = u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -449,7 +476,6 @@ impl Nlp for MinimaxProblem {
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
         let travel = travel_weight != 0.0;
-        let end = model.mesh.boundaries.len() - 1;
         self.workers
             .for_each_chunk(JOB_GRADIENT, &mut self.work, |j0, work| {
                 for (i, w) in work.iter_mut().enumerate() {
@@ -474,18 +500,9 @@ impl Nlp for MinimaxProblem {
                                 blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
                             }
                         }
-                        if let (true, Some(t)) = (tracked, targets) {
-                            let tj = &t[j];
-                            let wt = track_weight / tj.len() as f64;
-                            for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
-                                w.adj
-                                    .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
-                            }
-                        }
-                        if travel {
-                            let d = travel_cotangent(travel_weight, ks, shapes, end, j);
-                            w.adj.add_pos(end, 1.0, d);
-                        }
+                        let target = targets.as_ref().filter(|_| tracked).map(|t| &t[j][..]);
+                        let weights = (track_weight, travel_weight);
+                        add_track_travel(&mut w.adj, shapes, ks, j, target, weights);
                         w.adj.finish(model, &shapes[j], &mut w.ga);
                     }
                 }
@@ -548,19 +565,11 @@ impl Nlp for MinimaxProblem {
                     if let Some(sw) = swept {
                         sw.add_chord_cotangents(ii, &y[ns..], &interior_shapes, &mut w.adj);
                     }
-                    if let (true, Some(t)) = (tracked, targets) {
-                        let tj = &t[j];
-                        let wt = track_weight / tj.len() as f64;
-                        for (b, (x, xb)) in shape.positions.iter().zip(tj).enumerate() {
-                            w.adj
-                                .add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
-                        }
-                        model.add_positions_gauss_newton(shape, &vec![wt; tj.len()], ha);
-                    }
-                    if travel_weight != 0.0 {
-                        let end = model.mesh.boundaries.len() - 1;
-                        let d = travel_cotangent(travel_weight, ks, shapes, end, j);
-                        w.adj.add_pos(end, 1.0, d);
+                    let target = targets.as_ref().filter(|_| tracked).map(|t| &t[j][..]);
+                    let weights = (track_weight, travel_weight);
+                    let tracked_at = add_track_travel(&mut w.adj, shapes, ks, j, target, weights);
+                    if let Some((wt, points)) = tracked_at {
+                        model.add_positions_gauss_newton(shape, &vec![wt; points], ha);
                     }
                     w.adj.finish_hessian(model, shape, ha);
                     let sj = &s[row..row + per];
