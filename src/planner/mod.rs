@@ -41,7 +41,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
-pub use result::{PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing};
+pub use result::{
+    EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing,
+};
 use start::Verified;
 use starts::StartPlan;
 
@@ -221,6 +223,7 @@ fn end_shape(
     held: ([f64; 3], bool),
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
+    margin_cap: f64,
 ) -> Result<StaticSolution, PlanSetupError> {
     let seed = end_angles(end)
         .filter(|_| problem.statics.model.layout.spatial)
@@ -276,7 +279,7 @@ fn end_shape(
             (None, None) => problem.initial.clone(),
         };
         let sol = solve_static(&mut pose.problem(base), &a0, opts);
-        on_chords_if_dipping(problem, &pose, sol, fine, opts)
+        on_chords_if_dipping(problem, &pose, sol, fine, opts, margin_cap)
     };
     if sol.status != SolveStatus::Converged {
         let msg = if !end.is_pose() {
@@ -309,14 +312,18 @@ fn end_shape(
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
 /// where it dips into an obstacle between them on the verification grid (by more than the
 /// collision tolerance, 1e-6 L) and the same pose solved with the contacts on the chords
-/// between the points converges clear of the obstacles there, that shape: an end resting on an
-/// obstacle is a legal end of a path only when the verification grid finds it clear.
+/// between the points converges clear of the obstacles there, that shape; where that one still
+/// dips (the rod bulges into the obstacle between the points), the pose solved on the chords
+/// held off the obstacles by twice its depth (at most `margin_cap`, units of L), when that
+/// converges clear. An end resting on an obstacle is a legal end of a path only when the
+/// verification grid finds it clear.
 fn on_chords_if_dipping(
     problem: &PlanProblem,
     pose: &EndPose,
     sol: StaticSolution,
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
+    margin_cap: f64,
 ) -> StaticSolution {
     let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
     let depth = |a: &[f64]| {
@@ -333,8 +340,23 @@ fn on_chords_if_dipping(
         return sol;
     };
     let again = solve_static(&mut pose.problem(&chords), &sol.a, opts);
-    if again.status == SolveStatus::Converged && depth(&again.a) >= -tol {
-        again
+    if again.status != SolveStatus::Converged {
+        return sol;
+    }
+    let d = depth(&again.a);
+    if d >= -tol {
+        return again;
+    }
+    // Still inside (the rod bulges into the obstacle between the points): held off it by
+    // twice that depth, as the replayed equilibria are ([`Planner::judge_path`]).
+    let margin = -2.0 * d / problem.statics.model.rod.length;
+    if margin > margin_cap {
+        return sol;
+    }
+    let held = equilibrium_plan::held_off(&problem.statics, margin);
+    let off = solve_static(&mut pose.problem(&held), &again.a, opts);
+    if off.status == SolveStatus::Converged && depth(&off.a) >= -tol {
+        off
     } else {
         sol
     }
@@ -697,9 +719,26 @@ impl Planner {
         resolve(&mut start_end, "start", held.0)?;
         // The verification grid, on which an end shape resting on an obstacle must be clear.
         let fine = fine_model(model, settings.verify_s_samples, 4);
-        let start = end_shape(&problem, "start", &start_end, held, &fine, &static_options)?;
+        let cap = CONTACT_MARGIN_CAP * settings.coincide_tolerance;
+        let start = end_shape(
+            &problem,
+            "start",
+            &start_end,
+            held,
+            &fine,
+            &static_options,
+            cap,
+        )?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
-        let goal = end_shape(&problem, "goal", &goal_end, held, &fine, &static_options)?;
+        let goal = end_shape(
+            &problem,
+            "goal",
+            &goal_end,
+            held,
+            &fine,
+            &static_options,
+            cap,
+        )?;
         if let Some(w) = &settings.workspace {
             check_workspace(model, w, [("start", &start), ("goal", &goal)])?;
         }
@@ -740,6 +779,27 @@ impl Planner {
     /// [`PlanSettings::safety`]).
     pub fn safety(&self) -> f64 {
         self.settings.safety(self.base.model.rod.length)
+    }
+
+    /// The deepest place where the start or the goal shape lies inside an obstacle on the
+    /// verification grid (`fine`), deeper than the collision tolerance: an end the static
+    /// solve holds clear only at its contact points (see [`on_chords_if_dipping`]).
+    fn end_inside_obstacle(&self, fine: &crate::rod::model::Model) -> Option<EndInside> {
+        let tol = self.collision_tolerance();
+        [("start", &self.start), ("goal", &self.goal)]
+            .into_iter()
+            .flat_map(|(end, sol)| {
+                let (worst, _) =
+                    verify::shapes_clearance(fine, &self.obstacles, false, [(0.0, &sol.a[..])]);
+                worst.into_iter().map(move |w| EndInside {
+                    end,
+                    obstacle: w.obstacle,
+                    clearance: w.clearance,
+                    s: w.s,
+                })
+            })
+            .filter(|e| e.clearance < -tol)
+            .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
     }
 
     /// Depth below which a verified clearance counts as a collision (1e-6 L).
@@ -964,13 +1024,23 @@ impl Planner {
         observer.phase("optimise");
         self.poll(observer);
         let tol = self.collision_tolerance();
-        // The straight path when it already attains the lower bound and executes as it
-        // stands; else the starts.
-        let (runs, best, mut judged) = match self.straight_path_plan(&straight, observer) {
-            Some(j) => (Vec::new(), None, j),
-            None => {
-                let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
-                (runs, Some(best), judged)
+        // An end inside an obstacle: no path is collision-free, nothing to optimise. Else the
+        // straight path when it already attains the lower bound and executes as it stands;
+        // else the starts.
+        let end_inside = self.end_inside_obstacle(&fine);
+        let (runs, best, mut judged) = if end_inside.is_some() {
+            (
+                Vec::new(),
+                None,
+                Judged::not_run(self.settings.coincide_tolerance),
+            )
+        } else {
+            match self.straight_path_plan(&straight, observer) {
+                Some(j) => (Vec::new(), None, j),
+                None => {
+                    let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
+                    (runs, Some(best), judged)
+                }
             }
         };
         observer.phase("select");
@@ -998,6 +1068,7 @@ impl Planner {
         let straight_z = vec![0.0; straight_path.n_vars()];
         let mut along_straight = false;
         if !judged.executable
+            && end_inside.is_none()
             && judged.replay.start_held()
             && self.settings.equilibrium_plans
             && !self.stopped()
@@ -1060,7 +1131,7 @@ impl Planner {
         let workspace = judged_workspace.or_else(|| self.workspace_check(traj_path, traj_z));
         let status = if interrupted {
             PlanStatus::Interrupted
-        } else if !ver.collision_free(tol) {
+        } else if end_inside.is_some() || !ver.collision_free(tol) {
             PlanStatus::Collision
         } else if workspace.as_ref().is_some_and(|w| !w.within) {
             PlanStatus::OutsideWorkspace
@@ -1072,7 +1143,8 @@ impl Planner {
         PlanResult {
             status,
             optimiser,
-            straight_path_plan: best.is_none(),
+            straight_path_plan: best.is_none() && end_inside.is_none(),
+            end_inside_obstacle: end_inside,
             u_max: ver.u_max,
             k_at_u_max: ver.k_at_u_max,
             sampled_u_max: chosen.sampled_max,

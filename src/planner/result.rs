@@ -136,6 +136,12 @@ pub struct PlanResult {
     /// safety margin from the obstacles and coincides with its replay
     /// ([`super::PlanSettings::straight_path_first`]); `starts` is then empty.
     pub straight_path_plan: bool,
+    /// An end shape that lies inside an obstacle on the verification grid, deeper than the
+    /// collision tolerance, although its static solve holds it clear at the contact points
+    /// (and on their chords, tried when it dips): every path starts or ends there, so none is
+    /// collision-free, and the planner does not optimise (`starts` is empty, the replay is not
+    /// run, the status is `collision`).
+    pub end_inside_obstacle: Option<EndInside>,
     /// True `U_max` of the plan on the verification grid (case units).
     pub u_max: f64,
     /// `k` where it occurs.
@@ -228,6 +234,19 @@ impl PlanResult {
             PlanStatus::Planned => PlanVerdict::Departs,
         }
     }
+}
+
+/// Where an end shape lies inside an obstacle ([`PlanResult::end_inside_obstacle`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EndInside {
+    /// `"start"` or `"goal"`.
+    pub end: &'static str,
+    /// The obstacle's name.
+    pub obstacle: String,
+    /// Its clearance there (case units; negative: the depth).
+    pub clearance: f64,
+    /// Where along the rod (case units).
+    pub s: f64,
 }
 
 /// The controlled end against the workspace, on the verification grid in k.

@@ -165,6 +165,19 @@ pub(crate) fn run_plan(
             );
             ExitCode::from(EXIT_COLLISION)
         }
+        PlanVerdict::ObstacleCollision if result.end_inside_obstacle.is_some() => {
+            let e = result.end_inside_obstacle.as_ref().expect("matched");
+            eprintln!(
+                "error: {}: no collision-free plan: the {} shape itself comes {:.3e} inside obstacle {} at s = {:.4} (between the contact points its static solve holds clear), so no path from it is collision-free on the verification grid; {}",
+                path.display(),
+                e.end,
+                -e.clearance,
+                e.obstacle,
+                e.s,
+                TRY_END_INSIDE
+            );
+            ExitCode::from(EXIT_COLLISION)
+        }
         PlanVerdict::ObstacleCollision => {
             let worst = result
                 .verification
@@ -258,6 +271,10 @@ fn unreachable_end(c: &Case, json: bool, end: &str, message: &str) -> ExitCode {
 /// What to try when no plan is collision-free (the case file's `plan` fields).
 pub(crate) const TRY_COLLISION: &str = "try plan.swept_clearance: true, more plan.k_samples, more path terms (plan.fallback_path_terms, e.g. [6, 8]) or more plan.starts";
 
+/// What to try when an end shape lies inside an obstacle between its contact points.
+pub(crate) const TRY_END_INSIDE: &str =
+    "try an end pose farther from the obstacle, or more contact points (discretisation.samples)";
+
 /// Why the replayed equilibria are not a plan either, when they were checked.
 fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
     result
@@ -293,9 +310,13 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             None => "",
         },
         p.status,
-        match p.optimiser {
-            Some(o) => format!("optimiser {o}"),
-            None => "optimiser not run: the straight-line path attains the lower bound on U_max, the larger end energy".into(),
+        match (p.optimiser, &p.end_inside_obstacle) {
+            (Some(o), _) => format!("optimiser {o}"),
+            (None, Some(e)) => format!(
+                "optimiser not run: the {} shape lies inside obstacle {}, so no path is collision-free",
+                e.end, e.obstacle
+            ),
+            (None, None) => "optimiser not run: the straight-line path attains the lower bound on U_max, the larger end energy".into(),
         }
     );
     let _ = writeln!(
@@ -351,22 +372,26 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         );
     }
     let rp = &p.replay;
-    let _ = writeln!(
-        o,
-        "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snap-through at k = [{}]",
-        rp.max_deviation_over_l,
-        rp.k_at_max_deviation,
-        rp.tolerance,
-        if rp.coincide {
-            "coincide"
-        } else {
-            "DO NOT COINCIDE"
-        },
-        rp.u_max,
-        rp.all_stable,
-        rp.all_converged,
-        snap_list(&rp.snaps)
-    );
+    if rp.steps.is_empty() {
+        let _ = writeln!(o, "  replay: not run");
+    } else {
+        let _ = writeln!(
+            o,
+            "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snap-through at k = [{}]",
+            rp.max_deviation_over_l,
+            rp.k_at_max_deviation,
+            rp.tolerance,
+            if rp.coincide {
+                "coincide"
+            } else {
+                "DO NOT COINCIDE"
+            },
+            rp.u_max,
+            rp.all_stable,
+            rp.all_converged,
+            snap_list(&rp.snaps)
+        );
+    }
     if let Some(c) = rp.min_clearance {
         let contact = if rp.max_contact_force > 0.0 {
             format!(
@@ -420,18 +445,22 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         );
     }
     let t = &p.trajectory;
-    let _ = writeln!(
-        o,
-        "  gripper: path length {:.4e} (straight line {:.4e}), largest step {:.4e}; turns {:.4} rad (largest step {:.4} rad){}; poses {}",
-        t.path_length,
-        t.straight_distance,
-        t.largest_step,
-        t.rotation_angle,
-        t.largest_rotation_step,
-        t.duration_s
-            .map_or(String::new(), |d| format!("; duration {d:.3} s")),
-        r.trajectory_csv.as_deref().unwrap_or("not written")
-    );
+    if t.poses.is_empty() {
+        let _ = writeln!(o, "  gripper: no trajectory (the replay did not run)");
+    } else {
+        let _ = writeln!(
+            o,
+            "  gripper: path length {:.4e} (straight line {:.4e}), largest step {:.4e}; turns {:.4} rad (largest step {:.4} rad){}; poses {}",
+            t.path_length,
+            t.straight_distance,
+            t.largest_step,
+            t.rotation_angle,
+            t.largest_rotation_step,
+            t.duration_s
+                .map_or(String::new(), |d| format!("; duration {d:.3} s")),
+            r.trajectory_csv.as_deref().unwrap_or("not written")
+        );
+    }
     let _ = writeln!(
         o,
         "  log {} ({} shapes)   time: endpoints {:.3} s, plan {:.3} s, replay {:.3} s",
