@@ -335,6 +335,20 @@ fn clearance_on(
     worst
 }
 
+/// The suite's planar problem `planar_<seed>_<index>`: its case text and its planner, with the
+/// defaults.
+fn planar_planner(seed: u64, index: usize) -> (String, dlo_planner::planner::Planner) {
+    let mut rng = Rng(seed);
+    let text = (0..=index)
+        .map(|j| planar_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/planar.json"))
+        .expect("a generated case");
+    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    (text, p)
+}
+
 /// The suite's planar problem `planar_<seed>_<index>`, with the defaults, and its start pose
 /// solved with the contacts at the sample points (held as on the chords when `chords`), from the
 /// planner's start shape; checks that it holds the same end pose (1e-9) and that an obstacle
@@ -347,19 +361,10 @@ fn resting_start(
     dlo_planner::planner::Planner,
     dlo_planner::statics::StaticSolution,
 ) {
-    use dlo_planner::case;
     use dlo_planner::constraints::Constraint;
-    use dlo_planner::planner::Planner;
     use dlo_planner::planner::endpoints::EndPose;
     use dlo_planner::statics::solve_static;
-    let mut rng = Rng(seed);
-    let text = (0..=index)
-        .map(|j| planar_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
-    let c = case::parse(&text, std::path::Path::new("planning_cases/planar.json"))
-        .expect("a generated case");
-    let p = Planner::from_case(&c).expect("start and goal solve");
+    let (_, p) = planar_planner(seed, index);
     let model = &p.base.model;
     let mut base = p.base.clone();
     for con in base.constraints.iter_mut() {
@@ -464,17 +469,9 @@ fn an_end_bulging_into_an_obstacle_is_held_off_it_and_plans() {
 /// code 4 and names the end, the obstacle and the depth.
 #[test]
 fn an_end_inside_an_obstacle_is_reported_without_optimising() {
-    use dlo_planner::case;
     use dlo_planner::planner::verify::fine_model;
-    use dlo_planner::planner::{PlanStatus, PlanVerdict, Planner, observer::Silent};
-    let mut rng = Rng(5);
-    let text = (0..=11)
-        .map(|j| planar_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
-    let c = case::parse(&text, std::path::Path::new("planning_cases/planar_11.json"))
-        .expect("a generated case");
-    let p = Planner::from_case(&c).expect("start and goal solve");
+    use dlo_planner::planner::{PlanStatus, PlanVerdict, observer::Silent};
+    let (text, p) = planar_planner(5, 11);
     let l = p.base.model.rod.length;
     let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
     let depth = clearance_on(&p, &fine, &p.start.a);
