@@ -327,11 +327,8 @@ fn on_chords_if_dipping(
 ) -> StaticSolution {
     let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
     let depth = |a: &[f64]| {
-        let (worst, _) = verify::shapes_clearance(fine, &problem.obstacles, false, [(0.0, a)]);
-        worst
-            .iter()
-            .map(|w| w.clearance)
-            .fold(f64::INFINITY, f64::min)
+        verify::shape_worst_clearance(fine, &problem.obstacles, a)
+            .map_or(f64::INFINITY, |w| w.clearance)
     };
     if sol.status != SolveStatus::Converged || depth(&sol.a) >= -tol {
         return sol;
@@ -788,10 +785,9 @@ impl Planner {
         let tol = self.collision_tolerance();
         [("start", &self.start), ("goal", &self.goal)]
             .into_iter()
-            .flat_map(|(end, sol)| {
-                let (worst, _) =
-                    verify::shapes_clearance(fine, &self.obstacles, false, [(0.0, &sol.a[..])]);
-                worst.into_iter().map(move |w| EndInside {
+            .filter_map(|(end, sol)| {
+                let w = verify::shape_worst_clearance(fine, &self.obstacles, &sol.a)?;
+                Some(EndInside {
                     end,
                     obstacle: w.obstacle,
                     clearance: w.clearance,

@@ -138,7 +138,8 @@ pub struct PlanResult {
     pub straight_path_plan: bool,
     /// An end shape that lies inside an obstacle on the verification grid, deeper than the
     /// collision tolerance, although its static solve holds it clear at the contact points
-    /// (and on their chords, tried when it dips): every path starts or ends there, so none is
+    /// (and on their chords, then held off the obstacles, tried when it dips): every path
+    /// starts or ends there, so none is
     /// collision-free, and the planner does not optimise (`starts` is empty, the replay is not
     /// run, the status is `collision`).
     pub end_inside_obstacle: Option<EndInside>,

@@ -252,6 +252,19 @@ pub fn shapes_clearance<'a>(
     (worst, worst_self)
 }
 
+/// The worst obstacle clearance of the shape of coefficients `a` on the fine grid (the first
+/// obstacle among equals; `None` without obstacles).
+pub fn shape_worst_clearance(
+    fine: &Model,
+    obstacles: &[Arc<Obstacle>],
+    a: &[f64],
+) -> Option<ObstacleClearance> {
+    let (worst, _) = shapes_clearance(fine, obstacles, false, [(0.0, a)]);
+    worst
+        .into_iter()
+        .min_by(|p, q| p.clearance.total_cmp(&q.clearance))
+}
+
 /// Evaluates `path(z)` on `k_samples` uniform values of `k` with the fine model, and between
 /// them wherever a point could reach an obstacle (see [`verify_with`]).
 pub fn verify(
