@@ -5,9 +5,8 @@
 //! view; a 3D case adds a top view, z–y). Shapes are in the paper's axes: horizontal `z`,
 //! vertical `x` (up).
 
+use crate::output::foxglove::{Message, Pose, SceneUpdate};
 use crate::output::topics;
-use foxglove::Decode;
-use foxglove::schemas::{Pose, SceneUpdate};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::collections::BTreeMap;

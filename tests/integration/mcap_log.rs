@@ -4,12 +4,11 @@
 //! reference Python reader (`.ci/run`).
 
 use dlo_planner::case;
+use dlo_planner::output::foxglove::{FrameTransform, Message, PoseInFrame, SceneUpdate};
 use dlo_planner::output::mcap_log::recover::recover;
 use dlo_planner::output::mcap_log::{McapWriter, PlanLog, SharedWriter};
 use dlo_planner::planner::Planner;
 use dlo_planner::planner::observer::{PlanObserver, Progress, ShapeRecord};
-use foxglove::Decode;
-use foxglove::schemas::{FrameTransform, PoseInFrame, SceneUpdate};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;

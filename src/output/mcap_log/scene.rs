@@ -5,12 +5,12 @@
 //! `world → rod` maps the paper's x to Foxglove's z (up), its z to Foxglove's x, and its y to
 //! −y (a proper rotation: 180° about `(x + z)/√2`).
 
-use crate::scene::obstacle::{Obstacle, ObstacleShape};
-use foxglove::schemas::{
-    Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3, Pose,
-    PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp,
+use crate::output::foxglove::{
+    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3,
+    Pose, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp,
     TriangleListPrimitive, Vector3,
 };
+use crate::scene::obstacle::{Obstacle, ObstacleShape};
 
 /// Frame of everything the planner draws.
 pub const ROD_FRAME: &str = "rod";
@@ -133,22 +133,17 @@ pub fn gravity_transform(t: u64) -> FrameTransform {
 /// units), entity `id`.
 pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], thickness: f64, c: Color) -> SceneUpdate {
     SceneUpdate {
-        deletions: vec![],
         entities: vec![SceneEntity {
             timestamp: Some(stamp(t)),
             frame_id: ROD_FRAME.into(),
             id: id.into(),
-            lifetime: None,
-            frame_locked: false,
-            metadata: vec![],
             lines: vec![LinePrimitive {
-                r#type: foxglove::schemas::line_primitive::Type::LineStrip as i32,
+                r#type: LinePrimitive::LINE_STRIP,
                 pose: Some(Pose {
                     position: Some(v3([0.0; 3])),
                     orientation: Some(identity()),
                 }),
                 thickness,
-                scale_invariant: false,
                 points: points
                     .iter()
                     .map(|p| Point3 {
@@ -158,8 +153,6 @@ pub fn rod_update(t: u64, id: &str, points: &[[f64; 3]], thickness: f64, c: Colo
                     })
                     .collect(),
                 color: Some(c),
-                colors: vec![],
-                indices: vec![],
             }],
             ..Default::default()
         }],
@@ -192,7 +185,7 @@ pub fn fingers_update(t: u64, fingers: &[([f64; 3], [f64; 3])], length: f64) -> 
             let z = frame_with_z(*n);
             let m = [0, 1, 2].map(|i| [z[i][2], z[i][0], z[i][1]]);
             let tail = [0, 1, 2].map(|i| p[i] - len * n[i]);
-            foxglove::schemas::ArrowPrimitive {
+            ArrowPrimitive {
                 pose: Some(pose_of(tail, m)),
                 shaft_length: 0.7 * len,
                 shaft_diameter: 0.12 * len,
@@ -203,7 +196,6 @@ pub fn fingers_update(t: u64, fingers: &[([f64; 3], [f64; 3])], length: f64) -> 
         })
         .collect();
     SceneUpdate {
-        deletions: vec![],
         entities: vec![SceneEntity {
             timestamp: Some(stamp(t)),
             frame_id: ROD_FRAME.into(),
@@ -320,10 +312,7 @@ pub fn obstacles_update(
             e
         })
         .collect();
-    SceneUpdate {
-        deletions: vec![],
-        entities,
-    }
+    SceneUpdate { entities }
 }
 
 fn triangles(
@@ -346,8 +335,6 @@ fn triangles(
             })
             .collect(),
         color: Some(c),
-        colors: vec![],
-        indices: vec![],
     }
 }
 

@@ -1,7 +1,7 @@
 //! A streaming MCAP writer: LZ4-compressed chunks written as they fill, Foxglove's protobuf
 //! schemas registered on first use, JSON for numeric topics, and per-topic sequence numbers.
 
-use foxglove::Encode;
+use crate::output::foxglove::Schema;
 use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -128,24 +128,20 @@ impl<W: Write + Seek> McapWriter<W> {
     }
 
     /// Writes a Foxglove protobuf message on `topic` at `log_time` (ns).
-    pub fn proto<T: Encode>(
+    pub fn proto<T: Schema>(
         &mut self,
         topic: &str,
         log_time: u64,
         msg: &T,
     ) -> Result<(), LogError> {
-        let id = self.channel(topic, || {
-            let schema = T::get_schema().expect("Foxglove schemas carry a descriptor");
-            ChannelSpec {
-                schema_name: schema.name,
-                schema_encoding: schema.encoding,
-                schema: schema.data.into_owned(),
-                message_encoding: T::get_message_encoding(),
-            }
+        let id = self.channel(topic, || ChannelSpec {
+            schema_name: T::NAME.to_string(),
+            schema_encoding: "protobuf".to_string(),
+            schema: T::DESCRIPTOR.to_vec(),
+            message_encoding: "protobuf".to_string(),
         })?;
         self.buf.clear();
-        msg.encode(&mut self.buf)
-            .map_err(|e| std::io::Error::other(format!("encoding {topic}: {e:?}")))?;
+        msg.encode(&mut self.buf);
         self.put(id, log_time)
     }
 
