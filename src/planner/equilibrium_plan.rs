@@ -21,7 +21,7 @@
 use super::Planner;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
-use super::replay::{Replay, ReplayOptions, max_distance, replay};
+use super::replay::{EarlyStop, Replay, ReplayOptions, max_distance, replay};
 use crate::constraints::Constraint;
 use crate::rod::model::Model;
 use crate::statics::StaticProblem;
@@ -248,6 +248,7 @@ impl Planner {
         }
         let opts = ReplayOptions {
             steps: 2 * self.settings.replay_steps,
+            early_stop: EarlyStop::Unconverged,
             ..self.settings.replay()
         };
         let second = replay(

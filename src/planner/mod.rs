@@ -35,7 +35,7 @@ pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
 use observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
-use replay::{Replay, replay};
+use replay::{EarlyStop, Replay, ReplayOptions, replay};
 pub use settings::{Optimiser, PlanSettings, Workspace};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -540,16 +540,24 @@ impl Planner {
             .verification
             .collision_free(self.collision_tolerance())
             && run.plan.run.status == AlStatus::Converged;
-        self.judge_path(&path, &run.plan.run.z, planned, fine, observer)
+        self.judge_path(
+            &path,
+            &run.plan.run.z,
+            planned,
+            EarlyStop::Never,
+            fine,
+            observer,
+        )
     }
 
     /// The replay of `path(z)` from the start shape under `base` (the held problem, or a copy
-    /// with other contacts), with the plan's replay settings.
+    /// with other contacts), with the plan's replay settings, ended early by `early_stop`.
     fn replay_under(
         &self,
         base: &StaticProblem,
         path: &DeformationPath,
         z: &[f64],
+        early_stop: EarlyStop,
         observer: &mut dyn PlanObserver,
     ) -> Replay {
         replay(
@@ -557,7 +565,10 @@ impl Planner {
             &self.start,
             path,
             z,
-            self.settings.replay(),
+            ReplayOptions {
+                early_stop,
+                ..self.settings.replay()
+            },
             &self.static_options,
             observer,
             &self.stop,
@@ -565,18 +576,20 @@ impl Planner {
     }
 
     /// [`Self::judge`] of `path(z)`, executable as it stands when it coincides with its replay
-    /// and `planned` (collision-free and converged).
+    /// and `planned` (collision-free and converged); its replay ends early by `early_stop`
+    /// (the replays of the equilibria's retries end at a solve that does not converge).
     fn judge_path(
         &self,
         path: &DeformationPath,
         z: &[f64],
         planned: bool,
+        early_stop: EarlyStop,
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> Judged {
         let t = std::time::Instant::now();
         let mut rec = Recorder::new(observer);
-        let mut rep = self.replay_under(&self.base, path, z, &mut rec);
+        let mut rep = self.replay_under(&self.base, path, z, early_stop, &mut rec);
         let workspace = self.workspace_check(path, z);
         let within = workspace.is_none_or(|w| w.within);
         let as_planned = planned && rep.coincide;
@@ -594,7 +607,7 @@ impl Planner {
         {
             let mut attempt = |held: &StaticProblem| {
                 let mut rec = Recorder::new(observer);
-                let again = self.replay_under(held, path, z, &mut rec);
+                let again = self.replay_under(held, path, z, EarlyStop::Unconverged, &mut rec);
                 let plan = self.equilibrium_plan(held, path, z, &again, fine, &mut rec);
                 (again, plan, rec.into_shapes())
             };
@@ -1069,7 +1082,15 @@ impl Planner {
             && self.settings.equilibrium_plans
             && !self.stopped()
         {
-            let mut s = self.judge_path(&straight_path, &straight_z, false, &fine, observer);
+            // Only its equilibria can be the plan: its replay ends where a solve fails.
+            let mut s = self.judge_path(
+                &straight_path,
+                &straight_z,
+                false,
+                EarlyStop::Unconverged,
+                &fine,
+                observer,
+            );
             if let Some(e) = s.equilibrium_plan.as_mut() {
                 e.trajectory = "straight_path";
             }

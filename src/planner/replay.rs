@@ -124,6 +124,23 @@ pub struct ReplayOptions {
     pub refinements: usize,
     /// Coincidence tolerance (fraction of `L`).
     pub tolerance: f64,
+    /// What ends the replay before `k = 1`.
+    pub early_stop: EarlyStop,
+}
+
+/// What ends a replay before `k = 1`, for replays that only decide a question; a replay that
+/// stops early has a step with the reason last, and does not coincide.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EarlyStop {
+    /// Nothing: the whole path is replayed (the replay reported with a plan).
+    #[default]
+    Never,
+    /// A static solve that does not converge (whether the replayed equilibria are a plan: they
+    /// are not once one solve fails).
+    Unconverged,
+    /// That, a snap-through, or a shape farther from the path's than the tolerance (whether the
+    /// replay coincides with the path).
+    Departure,
 }
 
 struct State {
@@ -286,10 +303,25 @@ pub fn replay(
             },
         );
     };
+    // Whether the last step recorded ends the replay ([`EarlyStop`]).
+    let ends = |steps: &[ReplayStep], snaps: &[f64]| {
+        let last = steps.last().expect("a step");
+        match opts.early_stop {
+            EarlyStop::Never => false,
+            EarlyStop::Unconverged => !last.converged,
+            EarlyStop::Departure => {
+                !last.converged || !snaps.is_empty() || last.deviation > opts.tolerance * l
+            }
+        }
+    };
     let mut current = solve(0.0, &seed, &first_target);
     record(&current, &first_target, &mut steps, observer);
     let mut interrupted = false;
-    for i in 1..=opts.steps {
+    let mut stopped_early = ends(&steps, &snaps);
+    'steps: for i in 1..=opts.steps {
+        if stopped_early {
+            break;
+        }
         if super::observer::poll(observer, stop) {
             interrupted = true;
             break;
@@ -314,6 +346,10 @@ pub fn replay(
             }
             record(&next, &target, &mut steps, observer);
             current = next;
+            if ends(&steps, &snaps) {
+                stopped_early = true;
+                break 'steps;
+            }
         }
     }
     // The first step with the largest value of `f` (0 if none is positive).
@@ -341,7 +377,11 @@ pub fn replay(
         min_clearance: steps.iter().filter_map(|s| s.clearance).reduce(f64::min),
         max_contact_force: fmax,
         k_at_max_contact_force: steps[icf].k,
-        coincide: !interrupted && max_dev <= opts.tolerance && all_converged && snaps.is_empty(),
+        coincide: !interrupted
+            && !stopped_early
+            && max_dev <= opts.tolerance
+            && all_converged
+            && snaps.is_empty(),
         snaps,
         tolerance: opts.tolerance,
         start_deviation_over_l: steps[0].deviation / l,

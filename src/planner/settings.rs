@@ -1,7 +1,7 @@
 //! The settings of a plan: one struct, with the case file's names (the `plan` section's keys
 //! other than `start` and `goal`), defaults and validation. [`super::Planner::new`] takes it.
 
-use super::replay::ReplayOptions;
+use super::replay::{EarlyStop, ReplayOptions};
 use serde::{Deserialize, Serialize};
 
 /// How a plan is computed: the path's form, the optimiser's samples and continuation, the
@@ -348,6 +348,7 @@ impl PlanSettings {
             steps: self.replay_steps,
             refinements: self.replay_refinements,
             tolerance: self.coincide_tolerance,
+            early_stop: EarlyStop::Never,
         }
     }
 

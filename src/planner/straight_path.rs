@@ -10,6 +10,7 @@
 //! weighed against it; `docs/results.md` compares its gripper travel with the optimised plans'.
 
 use super::observer::{PlanObserver, Recorder};
+use super::replay::EarlyStop;
 use super::verify::Verification;
 use super::{Judged, Planner};
 use crate::constraints::Constraint;
@@ -59,7 +60,8 @@ impl Planner {
         let path = self.path();
         let z = vec![0.0; path.n_vars()];
         let mut rec = Recorder::new(observer);
-        let replay = self.replay_under(&self.base, &path, &z, &mut rec);
+        // Only a replay that coincides makes it the plan: it ends where it departs.
+        let replay = self.replay_under(&self.base, &path, &z, EarlyStop::Departure, &mut rec);
         let workspace = self.workspace_check(&path, &z);
         let within = workspace.is_none_or(|w| w.within);
         (replay.coincide && within && !self.stopped()).then(|| Judged {

@@ -179,6 +179,67 @@ fn plan_beats_hand_made_collision_free_paths() {
     );
 }
 
+/// A replay that only decides a question ends at its answer: on the paper's straight path
+/// (which runs through the block, so the replayed equilibria leave it), the replay that stops
+/// at a departure, and the one that stops at a solve that does not converge, are the full
+/// replay's first steps bit for bit, up to and including the first step that answers, and
+/// neither coincides when it stopped.
+#[test]
+fn a_replay_stopped_early_is_the_start_of_the_full_replay() {
+    use dlo_planner::planner::replay::{EarlyStop, ReplayOptions, replay};
+    let (p, _) = paper();
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let run = |early_stop| {
+        let opts = ReplayOptions {
+            early_stop,
+            ..p.settings.replay()
+        };
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        replay(
+            &p.base,
+            &p.start,
+            &path,
+            &z,
+            opts,
+            &p.static_options,
+            &mut Silent,
+            &stop,
+        )
+    };
+    let full = run(EarlyStop::Never);
+    let tol = full.tolerance * p.base.model.rod.length;
+    let departs = |s: &dlo_planner::planner::replay::ReplayStep| {
+        !s.converged || s.deviation > tol || full.snaps.contains(&s.k)
+    };
+    let first_departure = full.steps.iter().position(departs);
+    assert!(
+        first_departure.is_some_and(|i| i > 0 && i + 1 < full.steps.len()),
+        "the straight path departs inside (0, 1): {first_departure:?} of {}",
+        full.steps.len()
+    );
+    let first_unconverged = full.steps.iter().position(|s| !s.converged);
+    for (mode, answer) in [
+        (EarlyStop::Departure, first_departure),
+        (EarlyStop::Unconverged, first_unconverged),
+    ] {
+        let early = run(mode);
+        let n = answer.map_or(full.steps.len(), |i| i + 1);
+        assert_eq!(early.steps.len(), n, "{mode:?}");
+        for (a, b) in early.steps.iter().zip(&full.steps) {
+            assert_eq!(a.k.to_bits(), b.k.to_bits(), "{mode:?}");
+            assert_eq!(a.deviation.to_bits(), b.deviation.to_bits(), "{mode:?}");
+            assert!(
+                a.a.iter()
+                    .zip(&b.a)
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+            );
+        }
+        assert!(answer.is_none() || !early.coincide, "{mode:?}");
+    }
+    assert!(!full.coincide);
+}
+
 /// The replay starts on `a0` and ends on `a1`.
 #[test]
 fn replay_reproduces_start_and_goal() {

@@ -509,3 +509,68 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     assert_eq!(report["verdict"], "obstacle_collision");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The suite's 3D problem `spatial_6_9` (seed 6, which draws 67 planar problems before its 3D
+/// ones), with the defaults: its straight-line path runs through an obstacle, and from k ≈ 0.02
+/// on the static solves of the equilibria its end poses produce do not converge. A replay that
+/// ends at the first solve that does not converge (as the planner's fallbacks replay) is the
+/// full replay's first steps, bit for bit, up to and including that solve, and does not
+/// coincide.
+#[test]
+fn a_replay_ends_at_its_first_unconverged_solve() {
+    use dlo_planner::planner::replay::{EarlyStop, ReplayOptions, replay};
+    let mut rng = Rng(6);
+    for j in 0..67 {
+        planar_problem(&mut rng, j);
+    }
+    let text = (0..=9)
+        .map(|j| spatial_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let path = std::path::Path::new("planning_cases/spatial_6_9.json");
+    let c = dlo_planner::case::parse(&text, path).expect("a generated case");
+    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    let straight = p.path();
+    let z = vec![0.0; straight.n_vars()];
+    let run = |early_stop| {
+        let opts = ReplayOptions {
+            early_stop,
+            ..p.settings.replay()
+        };
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let mut silent = dlo_planner::planner::observer::Silent;
+        replay(
+            &p.base,
+            &p.start,
+            &straight,
+            &z,
+            opts,
+            &p.static_options,
+            &mut silent,
+            &stop,
+        )
+    };
+    let full = run(EarlyStop::Never);
+    let first = full
+        .steps
+        .iter()
+        .position(|s| !s.converged)
+        .expect("a solve that does not converge");
+    assert!(
+        first > 0 && first + 1 < full.steps.len(),
+        "{first} of {}",
+        full.steps.len()
+    );
+    let early = run(EarlyStop::Unconverged);
+    assert_eq!(early.steps.len(), first + 1);
+    for (a, b) in early.steps.iter().zip(&full.steps) {
+        assert_eq!(a.k.to_bits(), b.k.to_bits());
+        assert_eq!(a.converged, b.converged);
+        assert!(
+            a.a.iter()
+                .zip(&b.a)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+        );
+    }
+    assert!(!early.coincide && !early.all_converged);
+}
