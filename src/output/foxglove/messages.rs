@@ -371,8 +371,8 @@ mod tests {
         assert_eq!(checked, 61);
     }
 
-    #[test]
-    fn a_scene_update_with_every_primitive_round_trips() {
+    /// A scene update with one of every primitive, long enough for two-byte lengths.
+    fn every_primitive() -> SceneUpdate {
         let pose = Some(Pose {
             position: Some(Vector3 {
                 x: 1.0,
@@ -399,7 +399,7 @@ mod tests {
                 z: 1e-300,
             })
             .collect();
-        let up = SceneUpdate {
+        SceneUpdate {
             entities: vec![SceneEntity {
                 timestamp: Some(Timestamp::new(1_700_000_000, 1_500_000_000)),
                 frame_id: "rod".into(),
@@ -439,7 +439,12 @@ mod tests {
                     color: c,
                 }],
             }],
-        };
+        }
+    }
+
+    #[test]
+    fn a_scene_update_with_every_primitive_round_trips() {
+        let up = every_primitive();
         let bytes = up.encode_to_vec();
         assert_eq!(SceneUpdate::decode(&bytes), Ok(up.clone()));
         assert_eq!(
@@ -455,5 +460,41 @@ mod tests {
         let mut with_unknown = vec![0x0a, 0x00];
         with_unknown.extend_from_slice(&bytes);
         assert_eq!(SceneUpdate::decode(&with_unknown), Ok(up));
+    }
+
+    /// Damaged messages (a byte changed, inserted or cut off, or random bytes) decode to some
+    /// message or fail with an error: the decoder never panics, reads past the end, or loops.
+    #[test]
+    fn damaged_messages_decode_or_fail_without_panicking() {
+        let valid = every_primitive().encode_to_vec();
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut ok, mut failed) = (0, 0);
+        for round in 0..20_000 {
+            let mut b = valid.clone();
+            let at = (next() % b.len() as u64) as usize;
+            match round % 4 {
+                0 => b[at] ^= 1 << (next() % 8),
+                1 => b.insert(at, next() as u8),
+                2 => b.truncate(at),
+                _ => b = (0..next() % 64).map(|_| next() as u8).collect(),
+            }
+            match SceneUpdate::decode(&b) {
+                Ok(_) => ok += 1,
+                Err(DecodeError) => failed += 1,
+            }
+            let _ = PoseInFrame::decode(&b);
+            let _ = FrameTransform::decode(&b);
+        }
+        // Both outcomes occur: a changed double still decodes, a cut sub-message does not.
+        assert!(
+            ok > 1_000 && failed > 1_000,
+            "{ok} decoded, {failed} failed"
+        );
     }
 }
