@@ -186,27 +186,9 @@ fn plan_beats_hand_made_collision_free_paths() {
 /// neither coincides when it stopped.
 #[test]
 fn a_replay_stopped_early_is_the_start_of_the_full_replay() {
-    use dlo_planner::planner::replay::{EarlyStop, ReplayOptions, replay};
+    use dlo_planner::planner::replay::EarlyStop;
     let (p, _) = paper();
-    let path = p.path();
-    let z = vec![0.0; path.n_vars()];
-    let run = |early_stop| {
-        let opts = ReplayOptions {
-            early_stop,
-            ..p.settings.replay()
-        };
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        replay(
-            &p.base,
-            &p.start,
-            &path,
-            &z,
-            opts,
-            &p.static_options,
-            &mut Silent,
-            &stop,
-        )
-    };
+    let run = |early_stop| common::replay_straight_path(p, early_stop);
     let full = run(EarlyStop::Never);
     let tol = full.tolerance * p.base.model.rod.length;
     let departs = |s: &dlo_planner::planner::replay::ReplayStep| {

@@ -518,7 +518,7 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
 /// coincide.
 #[test]
 fn a_replay_ends_at_its_first_unconverged_solve() {
-    use dlo_planner::planner::replay::{EarlyStop, ReplayOptions, replay};
+    use dlo_planner::planner::replay::EarlyStop;
     let mut rng = Rng(6);
     for j in 0..67 {
         planar_problem(&mut rng, j);
@@ -530,26 +530,7 @@ fn a_replay_ends_at_its_first_unconverged_solve() {
     let path = std::path::Path::new("planning_cases/spatial_6_9.json");
     let c = dlo_planner::case::parse(&text, path).expect("a generated case");
     let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
-    let straight = p.path();
-    let z = vec![0.0; straight.n_vars()];
-    let run = |early_stop| {
-        let opts = ReplayOptions {
-            early_stop,
-            ..p.settings.replay()
-        };
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        let mut silent = dlo_planner::planner::observer::Silent;
-        replay(
-            &p.base,
-            &p.start,
-            &straight,
-            &z,
-            opts,
-            &p.static_options,
-            &mut silent,
-            &stop,
-        )
-    };
+    let run = |early_stop| crate::common::replay_straight_path(&p, early_stop);
     let full = run(EarlyStop::Never);
     let first = full
         .steps

@@ -223,3 +223,30 @@ pub fn run_batches<S: proptest::strategy::Strategy>(
     }
     run * u64::from(cases)
 }
+
+/// The straight-line path of `p` replayed from its start shape with the plan's replay settings,
+/// ended early by `early_stop`.
+pub fn replay_straight_path(
+    p: &dlo_planner::planner::Planner,
+    early_stop: dlo_planner::planner::replay::EarlyStop,
+) -> dlo_planner::planner::replay::Replay {
+    use dlo_planner::planner::replay::{ReplayOptions, replay};
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let opts = ReplayOptions {
+        early_stop,
+        ..p.settings.replay()
+    };
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut silent = dlo_planner::planner::observer::Silent;
+    replay(
+        &p.base,
+        &p.start,
+        &path,
+        &z,
+        opts,
+        &p.static_options,
+        &mut silent,
+        &stop,
+    )
+}
