@@ -54,6 +54,14 @@ const COLLISION_TOLERANCE: f64 = 1e-6;
 /// dip between contact points are held off the obstacles.
 const CONTACT_MARGIN_CAP: f64 = 0.05;
 
+/// The margin (units of L) by which a shape that dips `depth` (case units) into an obstacle
+/// between its contacts is solved again held off the obstacles: twice the depth, when that is
+/// positive and at most [`CONTACT_MARGIN_CAP`] of `coincide_tolerance` (a fraction of L).
+fn hold_off_margin(depth: f64, length: f64, coincide_tolerance: f64) -> Option<f64> {
+    let margin = 2.0 * depth / length;
+    (margin > 0.0 && margin <= CONTACT_MARGIN_CAP * coincide_tolerance).then_some(margin)
+}
+
 /// What to plan: the rod held at its base (its static problem: the fixed conditions,
 /// obstacles and self-contact), where its controlled end starts and where it goes.
 #[derive(Clone, Debug)]
@@ -223,7 +231,7 @@ fn end_shape(
     held: ([f64; 3], bool),
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
-    margin_cap: f64,
+    coincide_tolerance: f64,
 ) -> Result<StaticSolution, PlanSetupError> {
     let seed = end_angles(end)
         .filter(|_| problem.statics.model.layout.spatial)
@@ -279,7 +287,7 @@ fn end_shape(
             (None, None) => problem.initial.clone(),
         };
         let sol = solve_static(&mut pose.problem(base), &a0, opts);
-        on_chords_if_dipping(problem, &pose, sol, fine, opts, margin_cap)
+        on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
     };
     if sol.status != SolveStatus::Converged {
         let msg = if !end.is_pose() {
@@ -314,8 +322,8 @@ fn end_shape(
 /// collision tolerance, 1e-6 L) and the same pose solved with the contacts on the chords
 /// between the points converges clear of the obstacles there, that shape; where that one still
 /// dips (the rod bulges into the obstacle between the points), the pose solved on the chords
-/// held off the obstacles by twice its depth (at most `margin_cap`, units of L), when that
-/// converges clear. An end resting on an obstacle is a legal end of a path only when the
+/// held off the obstacles by [`hold_off_margin`] (of the plan's `coincide_tolerance`), when
+/// that converges clear. An end resting on an obstacle is a legal end of a path only when the
 /// verification grid finds it clear.
 fn on_chords_if_dipping(
     problem: &PlanProblem,
@@ -323,7 +331,7 @@ fn on_chords_if_dipping(
     sol: StaticSolution,
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
-    margin_cap: f64,
+    coincide_tolerance: f64,
 ) -> StaticSolution {
     let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
     let depth = |a: &[f64]| {
@@ -346,10 +354,10 @@ fn on_chords_if_dipping(
     }
     // Still inside (the rod bulges into the obstacle between the points): held off it by
     // twice that depth, as the replayed equilibria are ([`Planner::judge_path`]).
-    let margin = -2.0 * d / problem.statics.model.rod.length;
-    if margin > margin_cap {
+    let length = problem.statics.model.rod.length;
+    let Some(margin) = hold_off_margin(-d, length, coincide_tolerance) else {
         return sol;
-    }
+    };
     let held = equilibrium_plan::held_off(&problem.statics, margin);
     let off = solve_static(&mut pose.problem(&held), &again.a, opts);
     if off.status == SolveStatus::Converged && depth(&off.a) >= -tol {
@@ -630,9 +638,9 @@ impl Planner {
                 }
             }
             let l = self.base.model.rod.length;
-            let margin = 2.0 * depth / l;
-            let cap = CONTACT_MARGIN_CAP * self.settings.coincide_tolerance;
-            if !ep.executable && margin > 0.0 && margin <= cap && !self.stopped() {
+            let margin = hold_off_margin(depth, l, self.settings.coincide_tolerance)
+                .filter(|_| !ep.executable && !self.stopped());
+            if let Some(margin) = margin {
                 let (again, held, recorded) =
                     attempt(&equilibrium_plan::held_off(&self.base, margin));
                 if held.executable {
@@ -729,7 +737,6 @@ impl Planner {
         resolve(&mut start_end, "start", held.0)?;
         // The verification grid, on which an end shape resting on an obstacle must be clear.
         let fine = fine_model(model, settings.verify_s_samples, 4);
-        let cap = CONTACT_MARGIN_CAP * settings.coincide_tolerance;
         let start = end_shape(
             &problem,
             "start",
@@ -737,7 +744,7 @@ impl Planner {
             held,
             &fine,
             &static_options,
-            cap,
+            settings.coincide_tolerance,
         )?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
         let goal = end_shape(
@@ -747,7 +754,7 @@ impl Planner {
             held,
             &fine,
             &static_options,
-            cap,
+            settings.coincide_tolerance,
         )?;
         if let Some(w) = &settings.workspace {
             check_workspace(model, w, [("start", &start), ("goal", &goal)])?;
