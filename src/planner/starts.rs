@@ -91,6 +91,7 @@ impl Planner {
             self.base.objective,
             self.has_self_contact(),
             skip_inside,
+            &self.workers,
         )
     }
 

@@ -3,12 +3,17 @@
 //! between the optimiser's samples shows up here as a negative clearance.
 
 use crate::planner::path::DeformationPath;
+use crate::planner::workers::Workers;
 use crate::rod::energy::Objective;
 use crate::rod::kinematics::Shape;
 use crate::rod::model::{Discretisation, Model};
 use crate::scene::obstacle::Obstacle;
 use serde::Serialize;
 use std::sync::Arc;
+
+/// The verification's kind of job for [`Workers::for_each_chunk`] (the path optimisation's
+/// evaluations are the others).
+const JOB_VERIFY: usize = 3;
 
 /// The verification model: the case's rod with `s_intervals` uniform sample points as panel
 /// boundaries (a finer quadrature than the optimiser's as well), in the same angles' frame.
@@ -297,12 +302,35 @@ pub fn verify_with(
         objective,
         self_contact,
         false,
+        &Workers::serial(),
     )
 }
 
-/// [`verify_with`]; with `skip_inside`, for a report (the straight-line path's): where a point
-/// lies inside an obstacle at two consecutive grid values, the collision is reported on the
-/// grid, and the interval between them is not bisected to measure its depth there.
+/// One grid shape's verification: its energy (case units), points and gaps, each obstacle's
+/// worst clearance on it, and its self-contact gap.
+struct GridShape {
+    energy: f64,
+    gaps: ShapeGaps,
+    worst: Vec<ObstacleClearance>,
+    self_gap: Option<f64>,
+}
+
+/// Takes `part`'s worst clearances into `worst`, `part` coming after everything `worst` has
+/// seen: the first of equal minima stays, as if every shape had been recorded in order.
+fn merge(worst: &mut [ObstacleClearance], part: &[ObstacleClearance]) {
+    for (w, p) in worst.iter_mut().zip(part) {
+        if p.clearance < w.clearance {
+            *w = p.clone();
+        }
+    }
+}
+
+/// [`verify_with`], its shapes shared out over `workers` (each grid shape, then each interval
+/// between grid values, on its own; the parts are merged in `k` order, so that the result is
+/// the same bit for bit on any number of threads); with `skip_inside`, for a report (the
+/// straight-line path's): where a point lies inside an obstacle at two consecutive grid
+/// values, the collision is reported on the grid, and the interval between them is not
+/// bisected to measure its depth there.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn verify_grid(
     fine: &Model,
@@ -313,53 +341,76 @@ pub(crate) fn verify_grid(
     objective: Objective,
     self_contact: bool,
     skip_inside: bool,
+    workers: &Workers,
 ) -> Verification {
     let (chord_pts, pairs) = self_contact_chords(fine, self_contact);
-    let mut worst_self: Option<(f64, f64)> = None;
     let unit = fine.rod.energy_unit();
-    let mut a = vec![0.0; path.n()];
-    let mut shape = Shape::default();
-    let mut energies = Vec::with_capacity(k_samples);
     let ks: Vec<f64> = (0..k_samples)
         .map(|j| j as f64 / (k_samples - 1) as f64)
         .collect();
-    let mut worst = unseen(obstacles);
-    // Each grid shape's positions (case units) and, per obstacle, every point's surface gap,
-    // for the check between grid values below.
-    let mut grid: Vec<ShapeGaps> = Vec::with_capacity(k_samples);
-    for &k in &ks {
-        path.shape_at(z, k, &mut a);
-        fine.evaluate_into(&a, &mut shape);
-        let t = fine.energy(&a, &shape, objective, None);
-        energies.push(unit * t.value(objective));
-        if !obstacles.is_empty() {
-            let g = gaps_at(fine, obstacles, &shape.positions);
-            record(fine, &g.1, k, &mut worst);
-            grid.push(g);
+    let mut slots: Vec<Option<GridShape>> = (0..k_samples).map(|_| None).collect();
+    workers.for_each_chunk(JOB_VERIFY, &mut slots, |j0, chunk| {
+        let mut a = vec![0.0; path.n()];
+        let mut shape = Shape::default();
+        for (i, slot) in chunk.iter_mut().enumerate() {
+            let k = ks[j0 + i];
+            path.shape_at(z, k, &mut a);
+            fine.evaluate_into(&a, &mut shape);
+            let t = fine.energy(&a, &shape, objective, None);
+            let gaps = gaps_at(fine, obstacles, &shape.positions);
+            let mut worst = unseen(obstacles);
+            record(fine, &gaps.1, k, &mut worst);
+            *slot = Some(GridShape {
+                energy: unit * t.value(objective),
+                gaps,
+                worst,
+                self_gap: self_gap(fine, &chord_pts, &pairs, &shape.positions),
+            });
         }
-        if let Some(gap) = self_gap(fine, &chord_pts, &pairs, &shape.positions)
-            && worst_self.is_none_or(|(g, _)| gap < g)
+    });
+    let grid: Vec<GridShape> = slots
+        .into_iter()
+        .map(|g| g.expect("every grid shape is evaluated"))
+        .collect();
+    let mut worst = unseen(obstacles);
+    let mut worst_self: Option<(f64, f64)> = None;
+    for (g, &k) in grid.iter().zip(&ks) {
+        merge(&mut worst, &g.worst);
+        if let Some(gap) = g.self_gap
+            && worst_self.is_none_or(|(w, _)| gap < w)
         {
             worst_self = Some((gap, k));
         }
     }
+    let energies: Vec<f64> = grid.iter().map(|g| g.energy).collect();
     // Between grid values: a point moving from p to q keeps at least (g(p) + g(q) − |q − p|)/2
     // from an obstacle along the chord (the gap g is 1-Lipschitz). Where that bound goes below
     // zero, the interval is bisected (to 1/64 of it) and every shape evaluated there counts, so
     // that a path tunnelling between grid values is found instead of called collision-free.
-    for w in 0..grid.len().saturating_sub(1) {
-        let (k0, k1) = (ks[w], ks[w + 1]);
-        between(
-            fine,
-            path,
-            z,
-            obstacles,
-            (k0, &grid[w]),
-            (k1, &grid[w + 1]),
-            6,
-            skip_inside,
-            &mut worst,
-        );
+    if !obstacles.is_empty() {
+        let mut parts: Vec<Vec<ObstacleClearance>> = (0..k_samples.saturating_sub(1))
+            .map(|_| Vec::new())
+            .collect();
+        workers.for_each_chunk(JOB_VERIFY, &mut parts, |j0, chunk| {
+            for (i, part) in chunk.iter_mut().enumerate() {
+                let w = j0 + i;
+                *part = unseen(obstacles);
+                between(
+                    fine,
+                    path,
+                    z,
+                    obstacles,
+                    (ks[w], &grid[w].gaps),
+                    (ks[w + 1], &grid[w + 1].gaps),
+                    6,
+                    skip_inside,
+                    part,
+                );
+            }
+        });
+        for part in &parts {
+            merge(&mut worst, part);
+        }
     }
     let (jmax, &u_max) = energies
         .iter()
@@ -375,5 +426,50 @@ pub(crate) fn verify_grid(
         obstacles: worst,
         min_clearance,
         self_contact: worst_self,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's straight path runs 0.205 deep through the block, and a bent path near it
+    /// grazes the block's corner: the verification shared over three threads (six calls, so
+    /// that both ways of running its jobs are taken, [`Workers`]) gives the serial one bit for
+    /// bit, grid energies, each obstacle's worst clearance and where it lies, with and without
+    /// `skip_inside`.
+    #[test]
+    fn verification_is_the_same_on_any_number_of_threads() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("planning_cases/plan_paper_planar.json");
+        let case = crate::case::load(&file).expect("the shipped case loads");
+        let p = crate::planner::Planner::from_case(&case).expect("the shipped case plans");
+        let fine = fine_model(&p.base.model, 256, 4);
+        let path = p.path();
+        let bent: Vec<f64> = (0..path.n_vars())
+            .map(|i| 0.3 * ((i as f64) * 0.7).sin())
+            .collect();
+        let straight = vec![0.0; path.n_vars()];
+        let team = Workers::new(3);
+        for (z, skip_inside) in [(&straight, true), (&straight, false), (&bent, false)] {
+            let run = |w: &Workers| {
+                verify_grid(
+                    &fine,
+                    &path,
+                    z,
+                    201,
+                    &p.obstacles,
+                    p.base.objective,
+                    true,
+                    skip_inside,
+                    w,
+                )
+            };
+            let serial = run(&Workers::serial());
+            assert!(serial.min_clearance.is_some_and(|c| c.is_finite()));
+            for _ in 0..6 {
+                assert_eq!(format!("{:?}", run(&team)), format!("{serial:?}"));
+            }
+        }
     }
 }
