@@ -10,7 +10,7 @@ pub mod second_order;
 
 pub use augmented_lagrangian::{
     AlOptions, AlOutcome, AlStatus, OuterIterate, augmented_lagrangian,
-    augmented_lagrangian_observed,
+    augmented_lagrangian_observed, augmented_lagrangian_warm,
 };
 pub use bfgs::{BfgsOptions, BfgsOutcome, BfgsStatus, bfgs};
 pub use newton::{NewtonOptions, newton};

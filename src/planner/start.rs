@@ -9,7 +9,7 @@ use super::observer::Progress;
 use super::verify::Verification;
 use super::workers::Workers;
 use super::{Planner, settings};
-use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_observed};
+use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_warm};
 
 /// Optimality tolerance of a 3D rod's sharpness stages before the last (feasibility: a tenth
 /// of it); the last stage keeps [`Planner::stage_options`]'. On the generated suite (seeds 1
@@ -72,7 +72,8 @@ impl StartRun {
 }
 
 impl Planner {
-    /// The multiplier-method settings of each sharpness stage (the penalty restarts at 1e2).
+    /// The multiplier-method settings of each sharpness stage: the penalty starts at 1e2 (on a
+    /// 3D rod, only the first stage's: see [`Planner::stages_carry_curvature`]).
     pub fn stage_options(&self) -> AlOptions {
         AlOptions {
             feasibility_tol: 1e-6,
@@ -85,7 +86,25 @@ impl Planner {
             second_order: self.settings.optimiser == settings::Optimiser::Newton,
             max_step: f64::INFINITY,
             newton_multipliers: false,
+            hold_penalty_when_feasible: false,
         }
+    }
+
+    /// Whether each sharpness stage after the first starts from the BFGS curvature and the
+    /// penalty the stage before ended with, and holds the penalty while the path is feasible
+    /// ([`AlOptions::hold_penalty_when_feasible`]): on a 3D rod. (A refinement's rerun of the
+    /// sharpest stage starts afresh: its new samples make it another problem, and started from
+    /// the old curvature it left the pillar case without swept rows tunnelling.) Restarting both made every stage cost
+    /// about as much as the first: on the generated suite (seeds 1–7, 2026-12-04) carrying them
+    /// took the 3D plans executable from 202 to 204 of 210 and the slowest seed's
+    /// 95th-percentile plan time from 2.38 to 1.26 s. Planar stages restart both. Their local
+    /// minima are a coin toss that the restarts decide for the low route: carried, the
+    /// planar suite made no more plans executable (404 of 420) with medians about a quarter
+    /// lower, but the paper's case reached U_max 5.284 instead of 5.238 with the curvature
+    /// carried (5.642, departing from its replay, with the penalty carried too), and
+    /// equivalent spellings of its poses, equal to the last bits, reached different minima.
+    pub fn stages_carry_curvature(&self) -> bool {
+        self.base.model.layout.spatial
     }
 
     /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
@@ -120,6 +139,10 @@ impl Planner {
         };
         let al = self.stage_options();
         let mut z = z0;
+        let carry = self.stages_carry_curvature();
+        // BFGS's inverse-Hessian approximation (empty: a scaled identity).
+        let mut hinv = Vec::new();
+        let mut rho = al.rho_initial;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
             if self.over_budget(tally.evaluations) {
                 tally.status = AlStatus::IterationLimit;
@@ -137,17 +160,26 @@ impl Planner {
             } else {
                 al
             };
+            let al = AlOptions {
+                rho_initial: rho,
+                hold_penalty_when_feasible: carry,
+                ..al
+            };
+            if !carry {
+                hinv.clear();
+            }
             let out = {
                 let sink = &mut *sink;
                 let ks = p.ks.clone();
                 let mw = p.mean_weight;
                 // `q` is the problem evaluated at the iterate: its sampled energies and shapes
                 // are the iterate's.
-                augmented_lagrangian_observed(
+                augmented_lagrangian_warm(
                     &mut p,
                     &mut z,
                     tally.lambda.as_deref(),
                     al,
+                    &mut hinv,
                     &mut |it, q| {
                         let u = q.energies();
                         let (j, &umax) = u
@@ -173,6 +205,9 @@ impl Planner {
                     },
                 )
             };
+            if carry {
+                rho = out.rho.max(al.rho_initial);
+            }
             if tally.absorb(out) || self.stopped() {
                 break;
             }
