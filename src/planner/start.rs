@@ -94,10 +94,11 @@ impl Planner {
     /// penalty the stage before ended with, and holds the penalty while the path is feasible
     /// ([`AlOptions::hold_penalty_when_feasible`]): on a 3D rod. (A refinement's rerun of the
     /// sharpest stage starts afresh: its new samples make it another problem, and started from
-    /// the old curvature it left the pillar case without swept rows tunnelling.) Restarting both made every stage cost
-    /// about as much as the first: on the generated suite (seeds 1–7, 2026-12-04) carrying them
-    /// took the 3D plans executable from 202 to 204 of 210 and the slowest seed's
-    /// 95th-percentile plan time from 2.38 to 1.26 s. Planar stages restart both. Their local
+    /// the old curvature it left the pillar case without swept rows tunnelling.) Restarting
+    /// both made every stage cost about as much as the first: on the generated suite (seeds
+    /// 1–7, 2026-12-04) carrying them took the 3D plans executable from 202 to 204 of 210 and
+    /// the slowest seed's 95th-percentile plan time from 2.38 to 1.86 s. Planar stages restart
+    /// both. Their local
     /// minima are a coin toss that the restarts decide for the low route: carried, the
     /// planar suite made no more plans executable (404 of 420) with medians about a quarter
     /// lower, but the paper's case reached U_max 5.284 instead of 5.238 with the curvature
