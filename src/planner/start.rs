@@ -72,8 +72,8 @@ impl StartRun {
 }
 
 impl Planner {
-    /// The multiplier-method settings of each sharpness stage: the penalty starts at 1e2 (on a
-    /// 3D rod, only the first stage's: see [`Planner::stages_carry_curvature`]).
+    /// The multiplier-method settings of each sharpness stage: the penalty starts at 1e2 (only
+    /// the first stage's where stages carry it, [`Planner::stages_carry_curvature`]).
     pub fn stage_options(&self) -> AlOptions {
         AlOptions {
             feasibility_tol: 1e-6,
@@ -93,21 +93,22 @@ impl Planner {
     /// Whether each sharpness stage after the first starts from the BFGS curvature and the
     /// penalty the stage before ended with, and holds the penalty while the path is feasible
     /// ([`AlOptions::hold_penalty_when_feasible`]): on a 3D rod, and in the attempts after the
-    /// case's own (fallback path terms, the retry without the travel term), which have an
-    /// evaluation budget that cheaper stages stretch further: on the generated suite (seeds
-    /// 1–7, 2026-12-04) carried fallbacks made 408 planar plans of 420 executable, against 404,
-    /// every seed at 95 % or more. (A refinement's rerun of the
-    /// sharpest stage starts afresh: its new samples make it another problem, and started from
-    /// the old curvature it left the pillar case without swept rows tunnelling.) Restarting
-    /// both made every stage cost about as much as the first: on the generated suite (seeds
-    /// 1–7, 2026-12-04) carrying them took the 3D plans executable from 202 to 204 of 210 and
-    /// the slowest seed's 95th-percentile plan time from 2.38 to 1.86 s. A planar case's own
-    /// attempt restarts both at every stage. Its local
-    /// minima are a coin toss that the restarts decide for the low route: carried, the
-    /// planar suite made no more plans executable (404 of 420) with medians about a quarter
-    /// lower, but the paper's case reached U_max 5.284 instead of 5.238 with the curvature
-    /// carried (5.642, departing from its replay, with the penalty carried too), and
-    /// equivalent spellings of its poses, equal to the last bits, reached different minima.
+    /// case's own (fallback path terms, the retry without the travel term). A refinement's
+    /// rerun of the sharpest stage starts afresh: its new samples make it another problem, and
+    /// from the old curvature it left the pillar case without swept rows tunnelling.
+    ///
+    /// Restarting both made every stage cost about as much as the first. On the generated
+    /// suite (seeds 1–7, 2026-12-04), carrying them took the 3D plans executable from 202 to 204
+    /// of 210 and the slowest seed's 95th-percentile plan time from 2.38 to 1.86 s; in the
+    /// planar fallbacks, whose evaluation budget cheaper stages stretch further, it took the
+    /// planar plans executable from 404 to 408 of 420, every seed at 95 % or more.
+    ///
+    /// A planar case's own attempt restarts both at every stage: its local minima are a coin
+    /// toss that the restarts decide for the low route. Carried there, the planar suite made no
+    /// more plans executable (404 of 420) with medians about a quarter lower, but the paper's
+    /// case reached U_max 5.284 instead of 5.238 (5.642, departing from its replay, with the
+    /// penalty carried too), and equivalent spellings of its poses, equal to the last bits,
+    /// reached different minima.
     pub fn stages_carry_curvature(&self) -> bool {
         self.base.model.layout.spatial || self.budget.is_some()
     }
