@@ -17,7 +17,7 @@ use crate::optim::{Nlp, Sense};
 use crate::planner::clear_samples::ClearSamples;
 use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
-use crate::planner::workers::Workers;
+use crate::planner::workers::{JOB_GRADIENT, JOB_HESSIAN, JOB_VALUES, Workers};
 use crate::rod::energy::Objective;
 use crate::rod::hessian::add_rank_one;
 use crate::rod::kinematics::Shape;
@@ -64,11 +64,6 @@ pub struct MinimaxProblem {
     /// Threads the samples are split over ([`MinimaxProblem::set_workers`]).
     workers: Workers,
 }
-
-/// The kinds of job [`Workers`] runs for the problem (each runs shared or alone by its cost).
-const JOB_VALUES: usize = 0;
-const JOB_GRADIENT: usize = 1;
-const JOB_HESSIAN: usize = 2;
 
 /// One sample's results and scratch ([`MinimaxProblem`] evaluates the samples on any number of
 /// threads, each into its own slots, and sums them afterwards in sample order).

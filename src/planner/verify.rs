@@ -3,17 +3,13 @@
 //! between the optimiser's samples shows up here as a negative clearance.
 
 use crate::planner::path::DeformationPath;
-use crate::planner::workers::Workers;
+use crate::planner::workers::{JOB_VERIFY, Workers};
 use crate::rod::energy::Objective;
 use crate::rod::kinematics::Shape;
 use crate::rod::model::{Discretisation, Model};
 use crate::scene::obstacle::Obstacle;
 use serde::Serialize;
 use std::sync::Arc;
-
-/// The verification's kind of job for [`Workers::for_each_chunk`] (the path optimisation's
-/// evaluations are the others).
-const JOB_VERIFY: usize = 3;
 
 /// The verification model: the case's rod with `s_intervals` uniform sample points as panel
 /// boundaries (a finer quadrature than the optimiser's as well), in the same angles' frame.

@@ -21,8 +21,19 @@ pub const CHUNK: usize = 4;
 /// next one starts (waking a sleeping thread costs about as much as a planar evaluation).
 const SPIN: Duration = Duration::from_micros(100);
 
-/// Kinds of job a caller tells apart ([`Workers::for_each_chunk3`]'s `kind`).
-pub const KINDS: usize = 4;
+/// The kinds of job the planner tells apart ([`Workers::for_each_chunk3`]'s `kind`), each run
+/// shared or alone by what its own calls cost: the path optimisation's sampled values,
+/// gradients and Hessians ([`super::minimax::MinimaxProblem`]), and the verification's shapes
+/// ([`super::verify`]).
+pub const JOB_VALUES: usize = 0;
+/// See [`JOB_VALUES`].
+pub const JOB_GRADIENT: usize = 1;
+/// See [`JOB_VALUES`].
+pub const JOB_HESSIAN: usize = 2;
+/// See [`JOB_VALUES`].
+pub const JOB_VERIFY: usize = 3;
+/// How many kinds of job there are.
+pub const KINDS: usize = JOB_VERIFY + 1;
 
 /// Whether a kind of job runs shared or on the calling thread alone, by what each has cost
 /// lately. Sharing costs a hand-over, and a helper that looks for work slows a calling thread
