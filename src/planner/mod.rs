@@ -862,7 +862,7 @@ impl Planner {
         );
         p.mean_weight = self.settings.mean_weight;
         p.travel_weight = self.settings.travel_weight;
-        p.set_swept(self.settings.swept_clearance);
+        p.set_swept(self.settings.swept());
         p.set_skip_clear_samples(true);
         p
     }
@@ -1184,6 +1184,7 @@ impl Planner {
                         start: r.index,
                         path_terms: r.terms,
                         travel_weight: r.travel_weight,
+                        swept_clearance: r.swept_clearance,
                         status: v.run.status,
                         sampled_u_max: v.run.sampled_max,
                         u_max: v.verification.u_max,

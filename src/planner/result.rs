@@ -99,6 +99,10 @@ pub struct StartSummary {
     /// Weight of the travel term in the start's objective: the case's `travel_weight`, or 0
     /// for the last fallback's starts (the paper's objective).
     pub travel_weight: f64,
+    /// Whether the start's optimiser held the swept-clearance rows: the case's
+    /// `swept_clearance`, or on in the attempts after one whose plans all tunnelled through an
+    /// obstacle between their samples.
+    pub swept_clearance: bool,
     /// Final optimiser status.
     pub status: AlStatus,
     /// Largest sampled energy (case units).

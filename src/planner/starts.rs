@@ -22,6 +22,8 @@ pub(super) struct StartPlan {
     pub(super) terms: usize,
     /// Weight of the travel term in its objective.
     pub(super) travel_weight: f64,
+    /// Whether its optimiser held the swept-clearance rows.
+    pub(super) swept_clearance: bool,
     /// The plan, verified and refined.
     pub(super) plan: Verified,
 }
@@ -70,6 +72,13 @@ impl Planner {
     fn without_travel(&self) -> Planner {
         let mut p = self.clone();
         p.settings.travel_weight = 0.0;
+        p
+    }
+
+    /// The planner with the swept-clearance rows on, the same settings otherwise.
+    fn with_swept_clearance(&self) -> Planner {
+        let mut p = self.clone();
+        p.settings.swept_clearance = Some(true);
         p
     }
 
@@ -131,7 +140,17 @@ impl Planner {
         let attempts = std::iter::once(Cow::Borrowed(self))
             .chain(fallbacks.into_iter().map(|t| budget(self.with_terms(t))))
             .chain((self.settings.travel_weight > 0.0).then(|| budget(self.without_travel())));
+        // Unless the case says otherwise, once an attempt's plans all tunnel through an obstacle
+        // between their samples (the verification grid finds them colliding), the attempts
+        // after it hold the swept rows that stop a point from crossing a thin obstacle between
+        // two samples ([`super::PlanSettings::swept`]).
+        let mut tunnelled = false;
         'attempts: for (attempt, pl) in attempts.enumerate() {
+            let pl = if tunnelled && self.settings.swept_clearance.is_none() {
+                Cow::Owned(pl.with_swept_clearance())
+            } else {
+                pl
+            };
             let path = pl.path();
             let nv = path.n_vars();
             let check = |z: &[f64]| self.verify_on(fine, &path, z, false);
@@ -153,10 +172,13 @@ impl Planner {
                 .collect();
             for group in zs.chunks(self.settings.parallel_starts()) {
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
+                let tol = self.collision_tolerance();
+                tunnelled |= done.iter().all(|v| !v.verification.collision_free(tol));
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
                     terms: pl.settings.path_terms,
                     travel_weight: pl.settings.travel_weight,
+                    swept_clearance: pl.settings.swept(),
                     plan,
                 }));
                 // Checked before the next group, and before the next fallback planner is made.

@@ -548,7 +548,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     }
 
     // The paper's scheme as written (21 samples, no margin, no mean energy, no tracking, no
-    // refinement) tunnels through the block.
+    // refinement, no swept rows) tunnels through the block.
     let mut c: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
@@ -567,6 +567,7 @@ fn plan_prints_documented_json_and_exit_codes() {
         ("mean_weight", serde_json::json!(0.0)),
         ("equilibrium_weight", serde_json::json!(0.0)),
         ("sample_refinements", serde_json::json!(0)),
+        ("swept_clearance", serde_json::json!(false)),
     ] {
         c["plan"][k] = val;
     }
