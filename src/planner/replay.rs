@@ -2,9 +2,10 @@
 //! alone, solving the static shape at each `k` warm-started from the previous one, and compare
 //! the result with the optimal path.
 //!
-//! Where consecutive replayed shapes jump much more than the optimal path moves, the step is
-//! bisected (up to a limit); a jump that survives every bisection is a snap-through: the end
-//! pose alone cannot follow the path there.
+//! Where consecutive replayed shapes jump much more than the optimal path moves, or a solve
+//! from a converged shape does not converge, the step is bisected (up to a limit): a shorter
+//! step starts the solve nearer its answer. A jump that survives every bisection is a snap-through: the end pose
+//! alone cannot follow the path there.
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
@@ -327,7 +328,8 @@ pub fn replay(
             break;
         }
         let k_hi = i as f64 / opts.steps as f64;
-        // Advance from current.k to k_hi, bisecting where the replayed shape jumps.
+        // Advance from current.k to k_hi, bisecting where the replayed shape jumps or the
+        // solve does not converge.
         let mut pending = vec![(k_hi, 0usize)];
         while let Some((k, depth)) = pending.pop() {
             let target = optimal_at(k);
@@ -336,7 +338,11 @@ pub fn replay(
             let jump = max_distance(&next.positions, &current.positions);
             let moved = max_distance(&target.1, &prev_target.1);
             let jumped = jump > (3.0 * moved).max(0.02);
-            if jumped && depth < opts.refinements {
+            // Only from a converged shape: from one that did not converge, shorter steps
+            // mostly repeat the failure at many times the cost.
+            let failed = next.sol.status != SolveStatus::Converged
+                && current.sol.status == SolveStatus::Converged;
+            if (jumped || failed) && depth < opts.refinements {
                 pending.push((k, depth + 1));
                 pending.push((0.5 * (current.k + k), depth + 1));
                 continue;

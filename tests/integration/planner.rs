@@ -1779,3 +1779,62 @@ fn workspace_bounds_keep_the_gripper_inside() {
     let err = bounded(crossed).expect_err("crossed bounds").to_string();
     assert!(err.contains("workspace.min[0]"), "{err}");
 }
+
+/// A replay step whose solve does not converge is bisected like one that jumps: the paper's
+/// optimal path replayed on 4 steps by solves limited to 3 multiplier updates of 6 Newton steps
+/// each (and one more such budget, as every replay solve gets) cannot reach k = 0.25 in one
+/// step, and without bisections reports unconverged solves; with the default 4 bisections
+/// every solve converges, and the shapes at k = 0.25, 0.5, 0.75 and 1 are the default replay's
+/// (40 steps, full solves) within 1e-6 L.
+#[test]
+fn a_replay_step_that_does_not_converge_is_bisected() {
+    use dlo_planner::planner::replay::{ReplayOptions, replay};
+    let (p, r) = paper();
+    let path = p.with_terms(r.path_terms).path();
+    let mut weak = p.static_options;
+    weak.al.max_outer = 3;
+    weak.al.max_inner = 6;
+    let run = |refinements: usize| {
+        let opts = ReplayOptions {
+            steps: 4,
+            refinements,
+            ..p.settings.replay()
+        };
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        replay(
+            &p.base,
+            &p.start,
+            &path,
+            &r.z,
+            opts,
+            &weak,
+            &mut Silent,
+            &stop,
+        )
+    };
+    let plain = run(0);
+    assert!(
+        !plain.all_converged,
+        "every solve converged without bisection"
+    );
+    let bisected = run(4);
+    assert!(bisected.all_converged && bisected.snaps.is_empty());
+    assert!(bisected.steps.len() > 5, "no step was bisected");
+    for k in [0.25, 0.5, 0.75, 1.0] {
+        let at = |steps: &[dlo_planner::planner::replay::ReplayStep]| {
+            steps
+                .iter()
+                .find(|s| (s.k - k).abs() < 1e-12)
+                .expect("a step at k")
+                .positions
+                .clone()
+        };
+        let (a, b) = (at(&bisected.steps), at(&r.replay.steps));
+        let d = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        assert!(d <= 1e-6, "k = {k}: {d} L apart");
+    }
+}
