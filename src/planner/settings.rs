@@ -334,11 +334,12 @@ impl PlanSettings {
     /// Whether the path optimiser holds the swept-clearance rows from the first attempt on
     /// (`swept_clearance: true`). Left unset, they are off until an attempt's plans all tunnel
     /// through an obstacle between their samples, and on in every attempt after it: on the
-    /// generated suite (2026-12-04, seeds 11–16, which no setting was tuned on) that took the
-    /// planar plans executable from 343 to 352 of 360 (seeds 1–7: 408 to 409 of 420; 3D
-    /// unchanged), where a thin bar across the swing let every attempt's path cross it between
-    /// samples. Always on, the paper's planar case lands in a plan whose replay departs
-    /// (`docs/results.md`).
+    /// generated suite (2026-12-04) that took the planar plans executable from 343 to 352 of
+    /// 360 on seeds 11–16 (whose failures it came from: a thin bar across the swing that every
+    /// attempt's path crossed between samples) and from 408 to 409 of 420 on seeds 1–7, the 3D
+    /// ones unchanged; with the replay's bisection of unconverged steps, from 342 to 350 of 360
+    /// on seeds 21–26, run only afterwards. Always on, the paper's planar case lands in a plan
+    /// whose replay departs (`docs/results.md`).
     pub fn swept(&self) -> bool {
         self.swept_clearance == Some(true)
     }
