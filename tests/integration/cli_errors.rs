@@ -579,6 +579,13 @@ fn plan_prints_documented_json_and_exit_codes() {
     assert_eq!(v["status"], "collision");
     assert!(v["min_clearance"].as_f64().unwrap() < 0.0);
     assert!(err.contains("tunnels.json"), "{err}");
+    // `"swept_clearance": false`: no attempt holds the swept rows, though they all tunnel.
+    let starts = v["starts"].as_array().unwrap();
+    assert!(starts.len() > 1, "{starts:?}");
+    for s in starts {
+        assert_eq!(s["swept_clearance"], false, "{s}");
+        assert_eq!(s["collision_free"], false, "{s}");
+    }
     log_ok("tunnels");
 
     // A buckled arch planned to a turned end: the replay snaps through (tests/integration/planner.rs).
