@@ -4,8 +4,8 @@
 //!
 //! Where consecutive replayed shapes jump much more than the optimal path moves, or a solve
 //! from a converged shape does not converge, the step is bisected (up to a limit): a shorter
-//! step starts the solve nearer its answer. A jump that survives every bisection is a snap-through: the end pose
-//! alone cannot follow the path there.
+//! step starts the solve nearer its answer. A jump that survives every bisection is a
+//! snap-through: the end pose alone cannot follow the path there.
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};

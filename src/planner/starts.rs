@@ -2,7 +2,8 @@
 //! terms, then with each of `fallback_path_terms`, and last (when the objective has a travel
 //! term) with the case's path terms and the paper's objective, without the travel term, until
 //! the best plan so far is executable (its replay coincides with it, or its replayed equilibria
-//! are a plan); and which of the plans is the plan.
+//! are a plan); and which of the plans is the plan. Unless the case sets `swept_clearance`, the
+//! attempts after one whose plans all tunnel through an obstacle hold the swept rows.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
