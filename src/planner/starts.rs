@@ -173,8 +173,7 @@ impl Planner {
                 .collect();
             for group in zs.chunks(self.settings.parallel_starts()) {
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
-                let tol = self.collision_tolerance();
-                tunnelled |= done.iter().all(|v| !v.verification.collision_free(tol));
+                tunnelled |= done.iter().all(|v| !self.class(v).collision_free);
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
                     terms: pl.settings.path_terms,
