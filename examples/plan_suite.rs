@@ -213,6 +213,9 @@ pub struct Outcome {
     /// The replay's smallest clearance (units of L; infinite without obstacles), whether every
     /// replay solve converged and every replayed shape is stable.
     pub replay: (f64, bool, bool),
+    /// The attempt of every start that ran, in order, the chosen one marked `*` (`straight`:
+    /// the straight-line path, no start ran).
+    pub attempts: String,
 }
 
 /// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
@@ -344,6 +347,22 @@ pub fn run(
             r.replay.all_converged,
             r.replay.all_stable,
         ),
+        attempts: if r.starts.is_empty() {
+            "straight".into()
+        } else {
+            r.starts
+                .iter()
+                .map(|s| {
+                    let mark = if Some(s.start) == r.chosen_start {
+                        "*"
+                    } else {
+                        ""
+                    };
+                    format!("{}{mark}", s.attempt.name())
+                })
+                .collect::<Vec<_>>()
+                .join(",")
+        },
     })
 }
 
@@ -454,7 +473,7 @@ fn main() {
                 Some(o) => {
                     if verbose {
                         eprintln!(
-                            "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4} replay clearance {:+.2e} converged {} stable {}",
+                            "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4} replay clearance {:+.2e} converged {} stable {} attempts {}",
                             o.name,
                             o.planned,
                             o.coincide,
@@ -468,7 +487,8 @@ fn main() {
                             o.checked_clearance.map_or(f64::NAN, |c| c.1),
                             o.replay.0,
                             o.replay.1,
-                            o.replay.2
+                            o.replay.2,
+                            o.attempts
                         );
                         if let Some(why) = &o.why_not {
                             eprintln!("{:16} not executable: {why}", o.name);

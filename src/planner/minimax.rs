@@ -233,6 +233,16 @@ impl MinimaxProblem {
         &self.u
     }
 
+    /// Whether the largest sampled energy at the last evaluated point is at the first or the
+    /// last sample (`k = 0` or `k = 1`: an end shape's).
+    pub fn peaks_at_an_end(&self) -> bool {
+        let n = self.u.len();
+        let j = (0..n)
+            .max_by(|&a, &b| self.u[a].total_cmp(&self.u[b]).then(b.cmp(&a)))
+            .expect("samples");
+        j == 0 || j + 1 == n
+    }
+
     /// Sampled shapes' coefficients at the last evaluated point.
     pub fn sampled(&self) -> &[Vec<f64>] {
         &self.a

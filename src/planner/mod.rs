@@ -42,7 +42,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
 pub use result::{
-    EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing,
+    Attempt, EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing,
 };
 use start::Verified;
 use starts::StartPlan;
@@ -151,6 +151,8 @@ pub struct Planner {
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
     /// the case's own ([`PlanSettings::fallback_evaluations`]).
     budget: Option<usize>,
+    /// The quick first attempt of a planar rod ([`Attempt::Quick`]).
+    quick: bool,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
@@ -522,15 +524,18 @@ impl Planner {
     /// the lower index.
     fn best_of(&self, runs: &[StartPlan]) -> usize {
         (0..runs.len())
-            .max_by(|&i, &j| {
-                let (a, b) = (&runs[i].plan, &runs[j].plan);
-                self.class(a)
-                    .cmp(&self.class(b))
-                    .then(b.verification.u_max.total_cmp(&a.verification.u_max))
-                    .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
-                    .then(j.cmp(&i))
-            })
+            .max_by(|&i, &j| self.ranked(runs, i, j))
             .expect("at least one start")
+    }
+
+    /// How `runs[i]` compares with `runs[j]` in [`Self::best_of`]'s order (greater: better).
+    fn ranked(&self, runs: &[StartPlan], i: usize, j: usize) -> std::cmp::Ordering {
+        let (a, b) = (&runs[i].plan, &runs[j].plan);
+        self.class(a)
+            .cmp(&self.class(b))
+            .then(b.verification.u_max.total_cmp(&a.verification.u_max))
+            .then(b.run.sampled_max.total_cmp(&a.run.sampled_max))
+            .then(j.cmp(&i))
     }
 
     /// Replays `run`'s plan and, where the plan is not executable as it stands, checks its
@@ -769,6 +774,7 @@ impl Planner {
             linear_rows,
             stop: Arc::new(AtomicBool::new(false)),
             budget: None,
+            quick: false,
             workers: workers::Workers::new(settings.threads()),
             settings,
         })
@@ -949,32 +955,51 @@ impl Planner {
         (e, clearance(&self.base, &shape.positions))
     }
 
-    /// Runs the starts, replaying the best plan so far after each group (its shapes kept, to
-    /// be logged if it is chosen); returns every start's plan, the chosen one (the executable
-    /// one if any, else the best by class and `U_max`) and its judgement.
+    /// Runs the starts, replaying the best plan not yet replayed after each group (its shapes
+    /// kept, to be logged if it is chosen); returns every start's plan, the chosen one (the best
+    /// executable one if any, else the best by class and `U_max`) and its judgement.
     fn optimise_and_judge(
         &self,
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> (Vec<StartPlan>, usize, Judged) {
-        // The starts stop at the first executable plan, or as soon as a replay leaves the start
-        // shape at k = 0, which no path can change.
+        // The starts stop at the first executable plan (after the quick attempt, only one that
+        // attains the lower bound on U_max), or as soon as a replay leaves the start shape at
+        // k = 0, which no path can change.
         let mut judged: Vec<(usize, Judged)> = Vec::new();
-        let mut judge = |runs: &[StartPlan], observer: &mut dyn PlanObserver| -> bool {
-            let best = self.best_of(runs);
-            if let Some((_, j)) = judged.iter().find(|(i, _)| *i == best) {
-                return j.executable || !j.replay.start_held();
+        let mut judge = |runs: &[StartPlan], quick: bool, observer: &mut dyn PlanObserver| {
+            // The best plan not replayed yet (a plan replayed and found not executable does
+            // not stand in the way of the next attempt's).
+            let Some(best) = (0..runs.len())
+                .filter(|i| !judged.iter().any(|(j, _)| j == i))
+                .max_by(|&i, &j| self.ranked(runs, i, j))
+            else {
+                return false;
+            };
+            // A quick plan that peaks inside the path cannot end the search: not replayed yet.
+            if quick && !runs[best].plan.verification.peaks_at_an_end() {
+                return false;
             }
             let j = self.judge(&runs[best], fine, observer);
-            let stop = j.executable || !j.replay.start_held();
+            let (held, executable) = (j.replay.start_held(), j.executable);
             judged.push((best, j));
-            stop
+            if !held {
+                return true;
+            }
+            if quick {
+                executable && runs[best].plan.verification.peaks_at_an_end()
+            } else {
+                judged.iter().any(|(_, j)| j.executable)
+            }
         };
         let runs = self.run_starts(fine, observer, &mut judge);
+        // The best executable plan judged, else the best plan.
         let best = judged
             .iter()
-            .find(|(_, j)| j.executable)
-            .map_or_else(|| self.best_of(&runs), |(i, _)| *i);
+            .filter(|(_, j)| j.executable)
+            .map(|(i, _)| *i)
+            .max_by(|&i, &j| self.ranked(&runs, i, j))
+            .unwrap_or_else(|| self.best_of(&runs));
         let judged = match judged.into_iter().find(|(i, _)| *i == best) {
             Some((_, j)) => j,
             None if self.stopped() => Judged::not_run(self.settings.coincide_tolerance),
@@ -1182,6 +1207,7 @@ impl Planner {
                     let v = &r.plan;
                     StartSummary {
                         start: r.index,
+                        attempt: r.attempt,
                         path_terms: r.terms,
                         travel_weight: r.travel_weight,
                         swept_clearance: r.swept_clearance,
@@ -1198,10 +1224,7 @@ impl Planner {
                 })
                 .collect(),
             starts_not_run: self.settings.starts
-                - runs
-                    .iter()
-                    .filter(|r| r.index < self.settings.starts)
-                    .count(),
+                - runs.iter().filter(|r| r.attempt == Attempt::Own).count(),
             path_terms,
             chosen_start: best.map(|b| runs[b].index),
             path: path.c_vectors(&chosen.z),

@@ -89,11 +89,48 @@ impl std::fmt::Display for PlanVerdict {
     }
 }
 
+/// The attempt an optimiser start belongs to ([`StartSummary::attempt`]), in the order they
+/// run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Attempt {
+    /// A planar rod's first attempt: the first group of `parallel_starts` starts, with the
+    /// case's path terms and objective, their sharpness stages carrying the optimiser's
+    /// curvature and penalty from stage to stage and ending at the first converged stage whose
+    /// samples peak at an end shape. Its plan ends the search only when it is executable and
+    /// attains the lower bound on `U_max` (the larger end energy).
+    Quick,
+    /// The case's own path terms and objective (on a planar rod, every stage restarting the
+    /// optimiser's curvature and penalty).
+    Own,
+    /// A `fallback_path_terms` count.
+    Fallback,
+    /// The case's path terms without the travel term (the paper's objective).
+    WithoutTravel,
+}
+
+impl Attempt {
+    /// The attempt's name as the JSON report spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Attempt::Quick => "quick",
+            Attempt::Own => "own",
+            Attempt::Fallback => "fallback",
+            Attempt::WithoutTravel => "without_travel",
+        }
+    }
+}
+
 /// Summary of one optimiser start.
 #[derive(Clone, Debug, Serialize)]
 pub struct StartSummary {
-    /// Start index (the case's starts first, then each fallback path-term count's).
+    /// Start index, in the order the attempts run: the quick attempt's starts (planar rods),
+    /// the case's own, then each fallback path-term count's, then those without the travel
+    /// term; each attempt has `starts` indices, used or not (the quick attempt uses its
+    /// first `parallel_starts`).
     pub start: usize,
+    /// The attempt the start belongs to.
+    pub attempt: Attempt,
     /// Path terms `m` of the start's path.
     pub path_terms: usize,
     /// Weight of the travel term in the start's objective: the case's `travel_weight`, or 0
@@ -168,8 +205,10 @@ pub struct PlanResult {
     pub verification: Verification,
     /// Every start that ran.
     pub starts: Vec<StartSummary>,
-    /// Starts of the case that did not run: with `parallel_starts` below `starts`, a group of
-    /// starts runs only while the best plan so far is not executable.
+    /// Starts of the case's own attempt ([`Attempt::Own`]) that did not run: with
+    /// `parallel_starts` below `starts`, a group of starts runs only while no plan replayed so
+    /// far is executable, and none runs after an executable quick plan that attains the lower
+    /// bound.
     pub starts_not_run: usize,
     /// Path terms `m` of the plan: the case's `path_terms`, or the fallback count its start
     /// used.
@@ -318,6 +357,24 @@ impl<'a> PlanReport<'a> {
             mcap: None,
             log_shapes: None,
             trajectory_csv: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Attempt;
+
+    /// Each attempt's name (the CLI's summary) is the JSON report's spelling.
+    #[test]
+    fn attempt_names_are_the_json_spelling() {
+        for a in [
+            Attempt::Quick,
+            Attempt::Own,
+            Attempt::Fallback,
+            Attempt::WithoutTravel,
+        ] {
+            assert_eq!(serde_json::to_value(a).expect("serialises"), a.name());
         }
     }
 }

@@ -99,6 +99,12 @@ pub struct PlanSettings {
     /// safety margin from every obstacle, and coincides with its replay (see
     /// [`super::Planner::run`]); `false`: always optimise, as in the paper.
     pub straight_path_first: bool,
+    /// On a planar rod, run the quick attempt first ([`super::Attempt::Quick`]): the first
+    /// group of starts with their sharpness stages carrying the optimiser's curvature, whose
+    /// plan ends the search only when it is executable and attains the lower bound on `U_max`;
+    /// `false`: only the case's own attempt and those after it (no effect on a 3D rod, whose
+    /// own stages carry the curvature).
+    pub quick_attempt: bool,
 }
 
 /// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
@@ -158,6 +164,7 @@ impl Default for PlanSettings {
             equilibrium_plans: true,
             workspace: None,
             straight_path_first: true,
+            quick_attempt: true,
         }
     }
 }

@@ -50,6 +50,9 @@ pub(super) struct StartRun {
     /// The samples' largest distance to their equilibria after tracking (units of L): the
     /// replay's deviation estimated on the samples (`None` when not measured).
     pub(super) equilibrium_deviation: Option<f64>,
+    /// False for a quick start whose samples peak inside the path after its stages: it cannot
+    /// end the search, so it was neither tracked nor is it refined.
+    pub(super) settled: bool,
 }
 
 impl StartRun {
@@ -67,6 +70,7 @@ impl StartRun {
             tracking_rounds: 0,
             tracking_rounds_kept: 0,
             equilibrium_deviation: None,
+            settled: true,
         }
     }
 }
@@ -92,10 +96,11 @@ impl Planner {
 
     /// Whether each sharpness stage after the first starts from the BFGS curvature and the
     /// penalty the stage before ended with, and holds the penalty while the path is feasible
-    /// ([`AlOptions::hold_penalty_when_feasible`]): on a 3D rod, and in the attempts after the
-    /// case's own (fallback path terms, the retry without the travel term). A refinement's
-    /// rerun of the sharpest stage starts afresh: its new samples make it another problem, and
-    /// from the old curvature it left the pillar case without swept rows tunnelling.
+    /// ([`AlOptions::hold_penalty_when_feasible`]): on a 3D rod, in a planar rod's quick attempt
+    /// and in the attempts after the case's own (fallback path terms, the retry without the
+    /// travel term). A refinement's rerun of the sharpest stage starts afresh: its new samples
+    /// make it another problem, and from the old curvature it left the pillar case without
+    /// swept rows tunnelling.
     ///
     /// Restarting both made every stage cost about as much as the first. On the generated
     /// suite (seeds 1–7, 2026-12-04), carrying them took the 3D plans executable from 202 to 204
@@ -104,13 +109,12 @@ impl Planner {
     /// planar plans executable from 404 to 408 of 420, every seed at 95 % or more.
     ///
     /// A planar case's own attempt restarts both at every stage: its local minima are a coin
-    /// toss that the restarts decide for the low route. Carried there, the planar suite made no
-    /// more plans executable (404 of 420) with medians about a quarter lower, but the paper's
-    /// case reached U_max 5.284 instead of 5.238 (5.642, departing from its replay, with the
-    /// penalty carried too), and equivalent spellings of its poses, equal to the last bits,
-    /// reached different minima.
+    /// toss that the restarts decide for the low route. Carried there, the paper's case reached
+    /// U_max 5.284 instead of 5.238, and equivalent spellings of its poses, equal to the last
+    /// bits, reached different minima. The quick attempt carries them, and its plan ends the
+    /// search only where no route can be lower: where it attains the lower bound on U_max.
     pub fn stages_carry_curvature(&self) -> bool {
-        self.base.model.layout.spatial || self.budget.is_some()
+        self.base.model.layout.spatial || self.quick || self.budget.is_some()
     }
 
     /// Optimises from `z0` on the samples `ks`, from sharpness stage `first_stage` on, telling
@@ -217,13 +221,28 @@ impl Planner {
             if tally.absorb(out) || self.stopped() {
                 break;
             }
+            // The quick attempt's continuation ends at the first converged stage whose samples
+            // peak at an end shape: it has attained the lower bound on the samples, and the
+            // sharper stages could only move its interior below that peak.
+            if self.quick && tally.status == AlStatus::Converged {
+                crate::optim::Nlp::values(&mut p, &z, &mut c);
+                if p.peaks_at_an_end() {
+                    break;
+                }
+            }
         }
+        // A quick plan counts only where it attains the lower bound: one whose samples peak
+        // inside the path is left as the stages made it (no tracking, no sample refinement).
+        crate::optim::Nlp::values(&mut p, &z, &mut c);
+        let peaks_at_an_end = p.peaks_at_an_end();
+        let settled = !self.quick || peaks_at_an_end;
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
-        let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if !matches!(
-            tally.status,
-            AlStatus::NumericalFailure | AlStatus::Interrupted
-        ) {
+        let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if settled
+            && !matches!(
+                tally.status,
+                AlStatus::NumericalFailure | AlStatus::Interrupted
+            ) {
             self.track(&mut p, &mut z, &mut tally, al)
         } else {
             (0, 0, None)
@@ -244,6 +263,7 @@ impl Planner {
             tracking_rounds,
             tracking_rounds_kept,
             equilibrium_deviation,
+            settled,
         }
     }
 }
@@ -297,7 +317,11 @@ impl Planner {
         for _ in 0..self.settings.sample_refinements {
             let tunnels = !ver.collision_free(tol);
             let peak = missed_peak(&chosen, &ver);
-            if (!tunnels && !peak) || self.stopped() || self.over_budget(chosen.evaluations) {
+            if (!tunnels && !peak)
+                || !chosen.settled
+                || self.stopped()
+                || self.over_budget(chosen.evaluations)
+            {
                 break;
             }
             let worst_k: Vec<f64> = ver

@@ -1,12 +1,16 @@
-//! Which starts run: groups of `parallel_starts` starts side by side, first with the case's path
-//! terms, then with each of `fallback_path_terms`, and last (when the objective has a travel
-//! term) with the case's path terms and the paper's objective, without the travel term, until
-//! the best plan so far is executable (its replay coincides with it, or its replayed equilibria
-//! are a plan); and which of the plans is the plan. Unless the case sets `swept_clearance`, the
-//! attempts after one whose plans all tunnel through an obstacle hold the swept rows.
+//! Which starts run: groups of `parallel_starts` starts side by side; on a planar rod first the
+//! quick attempt ([`Attempt::Quick`]: the first group with the case's path terms, its stages
+//! carrying the optimiser's curvature), then with the case's path terms, then with each of
+//! `fallback_path_terms`, and last (when the objective has a travel term) with the case's path
+//! terms and the paper's objective, without the travel term, until a plan replayed after a
+//! group (the best not replayed yet) is executable (its replay coincides with it, or its
+//! replayed equilibria are a plan; after the quick attempt, only one that attains the lower
+//! bound on `U_max` ends the search); and which of the plans is the plan. Unless the case sets `swept_clearance`, the attempts after one whose plans all tunnel
+//! through an obstacle (other than the quick attempt) hold the swept rows.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
+use super::result::Attempt;
 use super::start::Verified;
 use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
@@ -19,6 +23,8 @@ pub(super) struct StartPlan {
     /// Index among the starts: the case's own starts first (`0..starts`), then each fallback
     /// count's (`starts..2·starts`, …).
     pub(super) index: usize,
+    /// The attempt it belongs to.
+    pub(super) attempt: Attempt,
     /// Path terms of its path.
     pub(super) terms: usize,
     /// Weight of the travel term in its objective.
@@ -28,6 +34,10 @@ pub(super) struct StartPlan {
     /// The plan, verified and refined.
     pub(super) plan: Verified,
 }
+
+/// Judges the plans so far (told whether they come from the quick attempt): true when they are
+/// good enough to end the search.
+pub(super) type Judge<'a> = dyn FnMut(&[StartPlan], bool, &mut dyn PlanObserver) -> bool + 'a;
 
 /// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
 fn noise(seed: u64, n: usize) -> Vec<f64> {
@@ -49,7 +59,7 @@ const FEASIBLE_ON_SAMPLES: f64 = 1e-6;
 
 /// The order in which plans are preferred before their `U_max`: collision-free on the
 /// verification grid first, then feasible on the optimiser's samples, then estimated to
-/// coincide with their replay (fields compared in that order).
+/// coincide with their replay, then settled (fields compared in that order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub(super) struct PlanClass {
     /// Clear of every obstacle and of itself on the verification grid.
@@ -58,6 +68,9 @@ pub(super) struct PlanClass {
     pub(super) feasible: bool,
     /// The sampled shapes lie within the coincidence tolerance of their equilibria.
     pub(super) coincides: bool,
+    /// Tracked and refined: not a quick plan left as its stages made it, peaking inside the
+    /// path ([`super::start::StartRun::settled`]).
+    pub(super) settled: bool,
 }
 
 impl Planner {
@@ -73,6 +86,14 @@ impl Planner {
     fn without_travel(&self) -> Planner {
         let mut p = self.clone();
         p.settings.travel_weight = 0.0;
+        p
+    }
+
+    /// The planner of the quick attempt ([`Attempt::Quick`]), with an evaluation budget.
+    fn quick(&self) -> Planner {
+        let mut p = self.clone();
+        p.quick = true;
+        p.budget = Some(self.settings.fallback_evaluations);
         p
     }
 
@@ -114,39 +135,53 @@ impl Planner {
                 .run
                 .equilibrium_deviation
                 .is_some_and(|d| d <= self.settings.coincide_tolerance),
+            settled: r.run.settled,
         }
     }
 
     /// Runs the starts in groups and the fallback path-term counts (see the module's doc),
-    /// verifying each plan on `fine`, until `judge` finds the plans so far good enough.
+    /// verifying each plan on `fine`, until `judge` finds the plans so far good enough (told
+    /// whether they come from the quick attempt).
     pub(super) fn run_starts(
         &self,
         fine: &Model,
         observer: &mut dyn PlanObserver,
-        judge: &mut dyn FnMut(&[StartPlan], &mut dyn PlanObserver) -> bool,
+        judge: &mut Judge<'_>,
     ) -> Vec<StartPlan> {
         let nk = self.settings.k_samples;
         let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
         let starts = self.settings.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
-        // The case's planner, then one per fallback count, then (with a travel term) the
-        // case's without it, each made only when it is reached. A route that must move the end
-        // away and back (two shapes at one pose) is one the travel term argues against.
-        // Each attempt after the first has an evaluation budget.
-        let fallbacks = self.settings.fallback_terms(self.base.model.layout.spatial);
+        // On a planar rod the quick attempt, then the case's planner, then one per fallback
+        // count, then (with a travel term) the case's without it, each made only when it is
+        // reached. A route that must move the end away and back (two shapes at one pose) is
+        // one the travel term argues against. Each attempt but the case's own has an
+        // evaluation budget. (On a 3D rod the case's own stages already carry the curvature.)
+        let spatial = self.base.model.layout.spatial;
+        let fallbacks = self.settings.fallback_terms(spatial);
         let budget = |mut p: Planner| {
             p.budget = Some(self.settings.fallback_evaluations);
             Cow::Owned(p)
         };
-        let attempts = std::iter::once(Cow::Borrowed(self))
-            .chain(fallbacks.into_iter().map(|t| budget(self.with_terms(t))))
-            .chain((self.settings.travel_weight > 0.0).then(|| budget(self.without_travel())));
+        let attempts = (!spatial && self.settings.quick_attempt)
+            .then(|| (Attempt::Quick, Cow::Owned(self.quick())))
+            .into_iter()
+            .chain(std::iter::once((Attempt::Own, Cow::Borrowed(self))))
+            .chain(
+                fallbacks
+                    .into_iter()
+                    .map(|t| (Attempt::Fallback, budget(self.with_terms(t)))),
+            )
+            .chain(
+                (self.settings.travel_weight > 0.0)
+                    .then(|| (Attempt::WithoutTravel, budget(self.without_travel()))),
+            );
         // Unless the case says otherwise, once an attempt's plans all tunnel through an obstacle
         // between their samples (the verification grid finds them colliding), the attempts
         // after it hold the swept rows that stop a point from crossing a thin obstacle between
         // two samples ([`super::PlanSettings::swept`]).
         let mut tunnelled = false;
-        'attempts: for (attempt, pl) in attempts.enumerate() {
+        'attempts: for (attempt, (kind, pl)) in attempts.enumerate() {
             let pl = if tunnelled && self.settings.swept_clearance.is_none() {
                 Cow::Owned(pl.with_swept_clearance())
             } else {
@@ -171,11 +206,21 @@ impl Planner {
                     (attempt * starts + s, z0)
                 })
                 .collect();
-            for group in zs.chunks(self.settings.parallel_starts()) {
+            // The quick attempt runs its first group only.
+            let groups = if kind == Attempt::Quick {
+                1
+            } else {
+                usize::MAX
+            };
+            for group in zs.chunks(self.settings.parallel_starts()).take(groups) {
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
-                tunnelled |= done.iter().all(|v| !self.class(v).collision_free);
+                // (The quick attempt's plans are not refined when they peak inside the path, so
+                // their collisions say nothing about the case's own attempt.)
+                tunnelled |=
+                    kind != Attempt::Quick && done.iter().all(|v| !self.class(v).collision_free);
                 runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
                     index: *index,
+                    attempt: kind,
                     terms: pl.settings.path_terms,
                     travel_weight: pl.settings.travel_weight,
                     swept_clearance: pl.settings.swept(),
@@ -185,7 +230,7 @@ impl Planner {
                 if self.stopped() {
                     break 'attempts;
                 }
-                if judge(&runs, observer) {
+                if judge(&runs, kind == Attempt::Quick, observer) {
                     break 'attempts;
                 }
             }

@@ -24,7 +24,7 @@ impl Planner {
     /// workspace, which the replay checks).
     pub(super) fn straight_path_attains_bound(&self, straight: &Verification) -> bool {
         let l = self.base.model.rod.length;
-        let at_end = straight.k_at_u_max == 0.0 || straight.k_at_u_max == 1.0;
+        let at_end = straight.peaks_at_an_end();
         let clear = straight
             .min_clearance
             .is_none_or(|c| c >= self.safety() * l)

@@ -77,6 +77,13 @@ impl Verification {
         self.min_clearance.is_none_or(|c| c >= -tol)
             && self.self_contact.is_none_or(|(g, _)| g >= -tol)
     }
+
+    /// Whether the grid's largest energy is at `k = 0` or `k = 1`: the path attains the lower
+    /// bound on every path's `U_max` (the larger end energy), since every path passes through
+    /// both end shapes.
+    pub fn peaks_at_an_end(&self) -> bool {
+        self.k_at_u_max == 0.0 || self.k_at_u_max == 1.0
+    }
 }
 
 /// A shape's points in case units and, per obstacle, every point's surface gap `d − r`.
@@ -111,13 +118,13 @@ fn record(fine: &Model, gaps: &[Vec<f64>], k: f64, worst: &mut [ObstacleClearanc
 }
 
 /// The smallest chord bound `(g(p) + g(q) − |q − p|)/2` of any point and obstacle between two
-/// shapes (case units); with `skip_inside`, leaving out points inside the obstacle in both
-/// shapes (their collision is on the grid already; bisecting only measures its depth).
+/// shapes (case units); with `skip_inside`, leaving out points inside the obstacle in either
+/// shape (their collision is on the grid already; bisecting only measures its depth).
 fn chord_bound(a: &ShapeGaps, b: &ShapeGaps, skip_inside: bool) -> f64 {
     let mut lo = f64::INFINITY;
     for (ga, gb) in a.1.iter().zip(&b.1) {
         for j in 0..a.0.len() {
-            if skip_inside && ga[j] < 0.0 && gb[j] < 0.0 {
+            if skip_inside && (ga[j] < 0.0 || gb[j] < 0.0) {
                 continue;
             }
             let (p, q) = (a.0[j], b.0[j]);
@@ -324,9 +331,9 @@ fn merge(worst: &mut [ObstacleClearance], part: &[ObstacleClearance]) {
 /// [`verify_with`], its shapes shared out over `workers` (each grid shape, then each interval
 /// between grid values, on its own; the parts are merged in `k` order, so that the result is
 /// the same bit for bit on any number of threads); with `skip_inside`, for a report (the
-/// straight-line path's): where a point lies inside an obstacle at two consecutive grid
-/// values, the collision is reported on the grid, and the interval between them is not
-/// bisected to measure its depth there.
+/// straight-line path's): where a point lies inside an obstacle at either of two consecutive
+/// grid values, the collision is reported on the grid, and the interval between them is not
+/// bisected for that point to measure its depth (or where it enters) there.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn verify_grid(
     fine: &Model,

@@ -477,6 +477,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     );
     let keys = [
         "start",
+        "attempt",
         "status",
         "sampled_u_max",
         "u_max",

@@ -8,7 +8,7 @@ use dlo_planner::case;
 use dlo_planner::planner::observer::Silent;
 use dlo_planner::planner::path::DeformationPath;
 use dlo_planner::planner::verify::{fine_model, verify};
-use dlo_planner::planner::{PlanStatus, Planner};
+use dlo_planner::planner::{Attempt, PlanStatus, Planner};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -35,8 +35,31 @@ fn paper_with(fields: serde_json::Value) -> dlo_planner::planner::PlanResult {
     Planner::from_case(&c).unwrap().run(&mut Silent)
 }
 
-/// The attempts after the case's own have an evaluation budget: on the paper's case with its
-/// three path terms (whose first start does not coincide) and no equilibrium plans, the
+/// The starts of `r` after its quick attempt's (one quick start runs first on a planar rod),
+/// and the chosen start's position among them.
+fn after_quick(
+    r: &dlo_planner::planner::PlanResult,
+) -> (Vec<&dlo_planner::planner::StartSummary>, Option<usize>) {
+    let quick = r
+        .starts
+        .iter()
+        .take_while(|s| s.attempt == Attempt::Quick)
+        .count();
+    assert!(
+        r.starts[quick..]
+            .iter()
+            .all(|s| s.attempt != Attempt::Quick)
+    );
+    let later: Vec<_> = r.starts[quick..].iter().collect();
+    let chosen = r
+        .chosen_start
+        .and_then(|c| later.iter().position(|s| s.start == c));
+    (later, chosen)
+}
+
+/// The attempts after the case's own have an evaluation budget (so has the quick attempt before
+/// it): on the paper's case with its three path terms (whose first start does not coincide)
+/// and no equilibrium plans, the
 /// six-term fallback stops its sharpness stages once it has used `fallback_evaluations` (checked
 /// between stages, so it may exceed it by one stage: with a budget of 100 it runs its first
 /// stage only), says `iteration_limit`, and its plan is still verified and reported; without
@@ -69,8 +92,10 @@ fn fallback_attempts_stop_at_their_evaluation_budget() {
     };
     let (limited, limited_stages) = run(100);
     let (free, free_stages) = run(100_000_000);
-    assert_eq!(limited.starts.len(), 2);
-    let (first, fallback) = (&limited.starts[0], &limited.starts[1]);
+    // The quick attempt (budgeted too), the case's own, the fallback.
+    let attempts: Vec<Attempt> = limited.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(attempts, [Attempt::Quick, Attempt::Own, Attempt::Fallback]);
+    let (first, fallback) = (&limited.starts[1], &limited.starts[2]);
     assert_eq!(first.path_terms, 3);
     assert_eq!(fallback.path_terms, 6);
     assert_eq!(
@@ -85,16 +110,19 @@ fn fallback_attempts_stop_at_their_evaluation_budget() {
     assert_eq!(limited_stages.get(&fallback.start), Some(&0));
     // The first attempt is the same with either budget; the unlimited fallback runs every stage,
     // converges and uses more evaluations than the budget allowed.
-    assert_eq!(free.starts[0].evaluations, first.evaluations);
-    assert_eq!(free_stages.get(&free.starts[1].start), Some(&sharpest));
+    let free_fallback = free.starts.last().expect("the fallback ran");
+    assert_eq!(free_fallback.attempt, Attempt::Fallback);
+    assert_eq!(free.starts[1].attempt, Attempt::Own);
+    assert_eq!(free.starts[1].evaluations, first.evaluations);
+    assert_eq!(free_stages.get(&free_fallback.start), Some(&sharpest));
     assert_eq!(
-        free.starts[1].status,
+        free_fallback.status,
         dlo_planner::optim::AlStatus::Converged
     );
     assert!(
-        free.starts[1].evaluations > fallback.evaluations,
+        free_fallback.evaluations > fallback.evaluations,
         "{} {}",
-        free.starts[1].evaluations,
+        free_fallback.evaluations,
         fallback.evaluations
     );
 }
@@ -387,17 +415,15 @@ fn paper_replay_coincides_from_other_starts() {
 /// is chosen; it is the single start of seed 15 bit for bit — when only an optimal path that
 /// coincides counts (`"equilibrium_plans": false`). By default the first start's replayed
 /// equilibria are a plan, and the second start does not run.
+/// (A quick start runs before them on a planar rod; on this case its plan peaks inside the
+/// path, so it is not replayed and does not count.)
 #[test]
 fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     let (p, r) = paper();
     assert_eq!(p.settings.parallel_starts(), 1);
-    assert_eq!(
-        (r.starts.len(), r.starts_not_run, r.chosen_start),
-        (1, 1, Some(0))
-    );
-    let est = r.starts[0]
-        .equilibrium_deviation
-        .expect("tracking measured it");
+    let (own, chosen) = after_quick(r);
+    assert_eq!((own.len(), r.starts_not_run, chosen), (1, 1, Some(0)));
+    let est = own[0].equilibrium_deviation.expect("tracking measured it");
     assert!(est <= p.settings.coincide_tolerance, "{est}");
     assert!(
         (est - r.replay.max_deviation_over_l).abs() < 1e-6,
@@ -408,19 +434,17 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     // Seed 14: the first start's plan departs from its replay, whose equilibria are a plan;
     // the second start does not run.
     let eq = paper_with(serde_json::json!({ "seed": 14 }));
-    assert_eq!((eq.starts.len(), eq.starts_not_run), (1, 1));
+    assert_eq!((after_quick(&eq).0.len(), eq.starts_not_run), (1, 1));
     assert!(!eq.replay.coincide);
     assert_eq!(eq.executed_path(), Some("equilibria"));
     // Only the optimal path as planned counts (`"equilibrium_plans": false`): the second runs.
     let r5 = paper_with(serde_json::json!({ "seed": 14, "equilibrium_plans": false }));
-    assert_eq!(
-        (r5.starts.len(), r5.starts_not_run, r5.chosen_start),
-        (2, 0, Some(1))
-    );
+    let (own5, chosen5) = after_quick(&r5);
+    assert_eq!((own5.len(), r5.starts_not_run, chosen5), (2, 0, Some(1)));
     assert_eq!(r5.executed_path(), Some("optimal"));
-    let first = r5.starts[0].equilibrium_deviation.expect("measured");
+    let first = own5[0].equilibrium_deviation.expect("measured");
     assert!(first > 0.02, "{first}");
-    assert!(r5.starts[1].equilibrium_deviation.expect("measured") <= 0.02);
+    assert!(own5[1].equilibrium_deviation.expect("measured") <= 0.02);
     assert!(r5.replay.coincide);
     let six = paper_with(serde_json::json!({
         "seed": 15, "starts": 1, "parallel_starts": 1, "equilibrium_plans": false
@@ -438,12 +462,12 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
 fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
     let (p, r) = paper();
     assert_eq!(p.settings.equilibrium_stop, 0.8);
-    let s = &r.starts[0];
+    let s = after_quick(r).0[0];
     assert_eq!((s.tracking_rounds, s.tracking_rounds_kept), (0, 0));
     let est = s.equilibrium_deviation.expect("measured");
     assert!(est <= 0.8 * p.settings.coincide_tolerance, "{est}");
     let tenth = paper_with(serde_json::json!({ "equilibrium_stop": 0.1 }));
-    let t = &tenth.starts[0];
+    let t = after_quick(&tenth).0[0];
     assert_eq!((t.tracking_rounds, t.tracking_rounds_kept), (1, 0));
     assert_eq!(tenth.z, r.z);
     assert_eq!(tenth.u_max.to_bits(), r.u_max.to_bits());
@@ -459,8 +483,9 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
 /// samples lie that far from their equilibria), so the first start with six terms runs, its
 /// plan is estimated at 1.4 % and coincides (measured 1.39 %), and it is the plan. Without the
 /// fallback the verdict is negative. (Only an optimal path that coincides counts here,
-/// `"equilibrium_plans": false`; by default the first start's replayed equilibria are a plan,
-/// and no other start runs.)
+/// `"equilibrium_plans": false`; by default the quick start's plan, which peaks at the goal
+/// shape, departs from its replay but its replayed equilibria are a plan, and no other start
+/// runs.)
 #[test]
 fn fallback_path_terms_make_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
@@ -473,21 +498,23 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
         });
         Planner::from_case(&c).unwrap().run(&mut Silent)
     };
+    // By default the quick start's plan peaks at the goal shape and its replayed equilibria
+    // are a plan: nothing else runs.
     let by_default = run(serde_json::json!({}));
     assert_eq!(by_default.starts.len(), 1);
+    assert_eq!(by_default.starts[0].attempt, Attempt::Quick);
+    assert_eq!(by_default.k_at_u_max, 1.0);
     assert_eq!(by_default.executed_path(), Some("equilibria"));
     let r = run(serde_json::json!({ "equilibrium_plans": false }));
     assert_eq!(r.status, PlanStatus::Planned);
-    let terms: Vec<usize> = r.starts.iter().map(|s| s.path_terms).collect();
+    let (later, chosen) = after_quick(&r);
+    let terms: Vec<usize> = later.iter().map(|s| s.path_terms).collect();
     assert_eq!(terms, [4, 4, 6]);
-    for s in &r.starts[..2] {
+    for s in &later[..2] {
         assert!(s.equilibrium_deviation.expect("measured") > 0.02);
     }
-    assert_eq!(
-        (r.chosen_start, r.path_terms, r.path.len()),
-        (Some(2), 6, 6)
-    );
-    assert!(r.starts[2].equilibrium_deviation.expect("measured") <= 0.02);
+    assert_eq!((chosen, r.path_terms, r.path.len()), (Some(2), 6, 6));
+    assert!(later[2].equilibrium_deviation.expect("measured") <= 0.02);
     assert!(
         r.replay.coincide && r.replay.max_deviation_over_l <= 0.02,
         "{}",
@@ -497,7 +524,7 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
     assert!(r.replay.start_deviation_over_l < 1e-6 && r.replay.end_deviation_over_l < 1e-6);
 
     let without = run(serde_json::json!({ "fallback_path_terms": [], "equilibrium_plans": false }));
-    assert_eq!(without.starts.len(), 2);
+    assert_eq!(after_quick(&without).0.len(), 2);
     assert!(
         !without.replay.coincide,
         "{}",
@@ -514,16 +541,17 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
 fn paper_two_starts_keep_the_better_verified_plan() {
     let r = paper_with(serde_json::json!({ "seed": 16, "equilibrium_plans": false }));
     assert_eq!(r.status, PlanStatus::Planned);
-    assert_eq!(r.starts.len(), 2);
-    assert!(r.starts.iter().all(|s| s.collision_free));
+    let (own, chosen) = after_quick(&r);
+    assert_eq!(own.len(), 2);
+    assert!(own.iter().all(|s| s.collision_free));
     assert!(
-        r.starts[0].u_max > r.starts[1].u_max + 0.05,
+        own[0].u_max > own[1].u_max + 0.05,
         "{} {}",
-        r.starts[0].u_max,
-        r.starts[1].u_max
+        own[0].u_max,
+        own[1].u_max
     );
-    assert_eq!(r.chosen_start, Some(1));
-    assert_eq!(r.u_max.to_bits(), r.starts[1].u_max.to_bits());
+    assert_eq!(chosen, Some(1));
+    assert_eq!(r.u_max.to_bits(), own[1].u_max.to_bits());
     assert!(
         r.replay.coincide && r.replay.max_deviation_over_l <= 0.02,
         "{}",
@@ -899,9 +927,10 @@ fn a_start_shape_its_pose_does_not_hold_ends_the_attempts() {
     let r = p.run(&mut Silent);
     assert!(!r.replay.start_held());
     assert!(r.replay.start_deviation_over_l > r.replay.tolerance);
+    // The quick start (not replayed: its plan peaks inside the path) and the case's own.
     assert_eq!(
-        r.starts.len(),
-        1,
+        r.starts.iter().map(|s| s.attempt).collect::<Vec<_>>(),
+        [Attempt::Quick, Attempt::Own],
         "attempts after the first: {:?}",
         r.starts
     );

@@ -81,19 +81,83 @@ fn suite_planar_plan_of(
     dlo_planner::planner::Planner,
     dlo_planner::planner::PlanResult,
 ) {
+    suite_planar_plan_with(seed, i, serde_json::json!({}))
+}
+
+/// The suite's planar problem `planar_{seed}_{i}`, planned with the `plan` settings `fields`
+/// and the defaults otherwise.
+fn suite_planar_plan_with(
+    seed: u64,
+    i: usize,
+    fields: serde_json::Value,
+) -> (
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::PlanResult,
+) {
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
     let mut rng = Rng(seed);
-    let text = (0..=i)
-        .map(|j| planar_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
+    let mut v: serde_json::Value = serde_json::from_str(
+        &(0..=i)
+            .map(|j| planar_problem(&mut rng, j))
+            .last()
+            .expect("a problem"),
+    )
+    .expect("generated JSON");
+    for (key, val) in fields.as_object().expect("an object") {
+        v["plan"][key] = val.clone();
+    }
+    let text = v.to_string();
     let path = format!("planning_cases/planar_{i}.json");
     let c = case::parse(&text, std::path::Path::new(&path)).expect("a generated case");
     let p = Planner::from_case(&c).expect("start and goal solve");
     let r = p.run(&mut Silent);
     (p, r)
+}
+
+/// The suite's planar problem `planar_1_25` (seed 1), planned with the defaults: the quick
+/// attempt's plan peaks at an end shape and coincides with its replay, so it is the plan and
+/// the case's own attempt does not run. Checked independently of the planner's grid: on 801
+/// values of k and 1024 intervals in s the plan's largest energy is the larger end energy (to
+/// 1e-9 relative: no path's can be lower, since every path passes through both end shapes),
+/// its clearance is at least −1e-6 L, and the case's own attempt alone (`"quick_attempt":
+/// false`) finds no lower U_max (to 1e-9).
+#[test]
+fn a_quick_plan_at_the_lower_bound_ends_the_search() {
+    use dlo_planner::planner::Attempt;
+    use dlo_planner::planner::verify::{fine_model, verify_with};
+    let (p, r) = suite_planar_plan(25);
+    let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick]);
+    assert_eq!(r.starts_not_run, p.settings.starts);
+    assert_eq!(r.chosen_start, Some(0));
+    assert_eq!(r.executed_path(), Some("optimal"));
+    assert!(r.replay.coincide && r.replay.max_deviation_over_l <= r.replay.tolerance);
+    let model = &p.base.model;
+    let l = model.rod.length;
+    let fine = fine_model(model, 1024, 4);
+    let path = p.with_terms(r.path_terms).path();
+    let v = verify_with(
+        &fine,
+        &path,
+        &r.z,
+        801,
+        &p.obstacles,
+        p.base.objective,
+        false,
+    );
+    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
+    assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    let (_, own) = suite_planar_plan_with(1, 25, serde_json::json!({ "quick_attempt": false }));
+    assert!(own.starts.iter().all(|s| s.attempt != Attempt::Quick));
+    assert!(
+        own.u_max >= r.u_max * (1.0 - 1e-9),
+        "{} vs {}",
+        own.u_max,
+        r.u_max
+    );
 }
 
 /// The suite's planar problem `planar_1_11` (seed 1), planned with the defaults: its optimal
@@ -236,15 +300,16 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
-/// The suite's planar problem `planar_1_8` (seed 1), planned with the defaults: its replayed
-/// equilibria dip into an obstacle between the contact points, and still do with the contacts
-/// on the chords between them. Held off the obstacles by twice that depth (within a twentieth
-/// of the coincidence tolerance), they are the executable plan, checked as above: held at the
-/// trajectory's poses, ending on the goal shape, no shape inside an obstacle on a grid four
-/// times finer in s.
+/// The suite's planar problem `planar_1_8` (seed 1), planned without the quick attempt
+/// (`"quick_attempt": false`; with it, the quick plan's replayed equilibria at the contact
+/// points are the plan): the replayed equilibria of the case's own plan dip into an obstacle
+/// between the contact points, and still do with the contacts on the chords between them.
+/// Held off the obstacles by twice that depth (within a twentieth of the coincidence
+/// tolerance), they are the executable plan, checked as above: held at the trajectory's poses,
+/// ending on the goal shape, no shape inside an obstacle on a grid four times finer in s.
 #[test]
 fn equilibria_that_dip_on_chords_too_are_held_off_by_twice_the_depth() {
-    let (p, r) = suite_planar_plan(8);
+    let (p, r) = suite_planar_plan_with(1, 8, serde_json::json!({ "quick_attempt": false }));
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");

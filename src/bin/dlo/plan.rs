@@ -338,6 +338,8 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             .starts
             .iter()
             .any(|s| s.path_terms != p.starts[0].path_terms);
+        // Starts of several attempts ran: say which each start belongs to.
+        let attempts = p.starts.iter().any(|s| s.attempt != p.starts[0].attempt);
         let not_run = if p.starts_not_run > 0 {
             format!(
                 " ({} more not run: an earlier plan is executable)",
@@ -365,7 +367,12 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                     } else {
                         String::new()
                     };
-                    format!("{m}{u:.4} ({us:.4}; {d}; {st:?}{clear})")
+                    let a = if attempts {
+                        format!("{}: ", s.attempt.name())
+                    } else {
+                        String::new()
+                    };
+                    format!("{a}{m}{u:.4} ({us:.4}; {d}; {st:?}{clear})")
                 })
                 .collect::<Vec<_>>()
                 .join(", ")
