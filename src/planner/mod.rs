@@ -963,9 +963,9 @@ impl Planner {
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> (Vec<StartPlan>, usize, Judged) {
-        // The starts stop at the first executable plan (after the quick attempt, only one that
-        // attains the lower bound on U_max), or as soon as a replay leaves the start shape at
-        // k = 0, which no path can change.
+        // The starts stop once a replayed plan is executable (after the quick attempt, only
+        // one that attains the lower bound on U_max), or as soon as a replay leaves the start
+        // shape at k = 0, which no path can change.
         let mut judged: Vec<(usize, Judged)> = Vec::new();
         let mut judge = |runs: &[StartPlan], quick: bool, observer: &mut dyn PlanObserver| {
             // The best plan not replayed yet (a plan replayed and found not executable does

@@ -20,8 +20,9 @@ use std::borrow::Cow;
 /// One start's verified plan and the path-term count it was planned with.
 #[derive(Clone)]
 pub(super) struct StartPlan {
-    /// Index among the starts: the case's own starts first (`0..starts`), then each fallback
-    /// count's (`starts..2·starts`, …).
+    /// Index among the starts: `starts` per attempt, in the order the attempts run (on a
+    /// planar rod the quick attempt's `0..starts`, of which its first group runs, then the
+    /// case's own, then each fallback count's, …).
     pub(super) index: usize,
     /// The attempt it belongs to.
     pub(super) attempt: Attempt,
