@@ -47,8 +47,9 @@ pub struct PlanSettings {
     pub equilibrium_rounds: usize,
     /// Tracking stops once the sampled shapes lie within this fraction of
     /// `coincide_tolerance` from their equilibria (0: only the rounds' budget and their
-    /// progress stop it).
-    pub equilibrium_stop: f64,
+    /// progress stop it). Default (absent): 0.5 on a planar rod, 0.1 on a 3D rod (see
+    /// [`PlanSettings::tracking_stop`]).
+    pub equilibrium_stop: Option<f64>,
     /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
     pub sharpness: Vec<f64>,
     /// Independent optimiser starts (run in parallel, each verified and refined on its own; the
@@ -147,7 +148,7 @@ impl Default for PlanSettings {
             travel_weight: d_travel(),
             equilibrium_weight: None,
             equilibrium_rounds: d_rounds(),
-            equilibrium_stop: d_track_stop(),
+            equilibrium_stop: None,
             sharpness: d_sharp(),
             starts: d_starts(),
             parallel_starts: None,
@@ -273,8 +274,9 @@ impl PlanSettings {
         if self.equilibrium_rounds > 50 {
             return Err(bad("equilibrium_rounds", "must be at most 50"));
         }
-        let stop = finite("equilibrium_stop", self.equilibrium_stop)?;
-        if !(0.0..1.0).contains(&stop) {
+        if let Some(stop) = self.equilibrium_stop
+            && !(0.0..1.0).contains(&finite("equilibrium_stop", stop)?)
+        {
             return Err(bad(
                 "equilibrium_stop",
                 format!(
@@ -349,6 +351,23 @@ impl PlanSettings {
     /// whose replay departs (`docs/results.md`).
     pub fn swept(&self) -> bool {
         self.swept_clearance == Some(true)
+    }
+
+    /// The fraction of `coincide_tolerance` within which tracking stops: `equilibrium_stop`,
+    /// or by default 0.5 on a planar rod and 0.1 on a 3D one (where tracking is off unless the
+    /// case sets `equilibrium_weight`; the shipped 3D cases that do were measured with 0.1).
+    /// The samples' distance to their equilibria estimates the replay's deviation to within
+    /// 4e-4 L on every start measured, so a plan stopped at half the tolerance still coincides
+    /// with a margin. On the generated suite's planar problems (19 seeds, 2026-12-04, each
+    /// seed with 0.1 and 0.5 back to back) half the tolerance left every verdict as it was
+    /// (1,129 of 1,140 executable, 874 coinciding either way) and lowered the median plan time
+    /// on 18 seeds (0.084–0.174 s → 0.071–0.148 s).
+    pub fn tracking_stop(&self, spatial: bool) -> f64 {
+        match self.equilibrium_stop {
+            Some(s) => s,
+            None if spatial => 0.1,
+            None => 0.5,
+        }
     }
 
     /// The equilibrium-tracking weight: `equilibrium_weight`, or by default 10,000 on a planar
@@ -453,9 +472,6 @@ fn d_travel() -> f64 {
     // On the generated suite (seeds 1 and 2), 0.5 made the most plans executable and coincide
     // among 0, 0.1, 0.25, 0.5 and 1 (docs/results.md).
     0.5
-}
-fn d_track_stop() -> f64 {
-    0.1
 }
 fn d_fallback_evaluations() -> usize {
     10_000

@@ -49,7 +49,8 @@ impl Planner {
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of
         // the coincidence tolerance from their equilibria, or when a round brought them less
         // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
-        let done = self.settings.equilibrium_stop * self.settings.coincide_tolerance;
+        let spatial = self.base.model.layout.spatial;
+        let done = self.settings.tracking_stop(spatial) * self.settings.coincide_tolerance;
         let mut dev_prev = f64::INFINITY;
         // The path before the last round, with its tally: a round that leaves the samples
         // farther from their equilibria is undone.

@@ -455,13 +455,13 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
 
 /// The shipped case stops equilibrium tracking once the samples lie within 80 % of the
 /// tolerance from their equilibria (`"equilibrium_stop": 0.8`): its first start's samples do
-/// after the sharpness stages (measured 1.46 % of L), so it runs no round. With the default
-/// stop (a tenth of the tolerance) it runs one, which leaves the samples farther from their
-/// equilibria and is undone: the plan is the same bit for bit, at the cost of that round.
+/// after the sharpness stages (measured 1.46 % of L), so it runs no round. With a stop at a
+/// tenth of the tolerance (the 3D default) it runs one, which leaves the samples farther from
+/// their equilibria and is undone: the plan is the same bit for bit, at the cost of that round.
 #[test]
 fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
     let (p, r) = paper();
-    assert_eq!(p.settings.equilibrium_stop, 0.8);
+    assert_eq!(p.settings.equilibrium_stop, Some(0.8));
     let s = after_quick(r).0[0];
     assert_eq!((s.tracking_rounds, s.tracking_rounds_kept), (0, 0));
     let est = s.equilibrium_deviation.expect("measured");
@@ -1285,7 +1285,7 @@ fn pillar_case_3d_coincides() {
     assert_eq!(r.starts[0].tracking_rounds_kept, 1);
     let est = r.starts[0].equilibrium_deviation.expect("measured");
     assert!(
-        est <= p.settings.equilibrium_stop * p.settings.coincide_tolerance,
+        est <= p.settings.tracking_stop(true) * p.settings.coincide_tolerance,
         "{est}"
     );
     let c = shipped_variant(name, |v| v["plan"]["equilibrium_rounds"] = 1.into());
