@@ -233,9 +233,10 @@ impl Planner {
         }
         // A quick plan counts only where it attains the lower bound: one whose samples peak
         // inside the path is left as the stages made it (no tracking, no sample refinement).
-        crate::optim::Nlp::values(&mut p, &z, &mut c);
-        let peaks_at_an_end = p.peaks_at_an_end();
-        let settled = !self.quick || peaks_at_an_end;
+        let settled = !self.quick || {
+            crate::optim::Nlp::values(&mut p, &z, &mut c);
+            p.peaks_at_an_end()
+        };
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
         let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if settled

@@ -5,8 +5,9 @@
 //! terms and the paper's objective, without the travel term, until a plan replayed after a
 //! group (the best not replayed yet) is executable (its replay coincides with it, or its
 //! replayed equilibria are a plan; after the quick attempt, only one that attains the lower
-//! bound on `U_max` ends the search); and which of the plans is the plan. Unless the case sets `swept_clearance`, the attempts after one whose plans all tunnel
-//! through an obstacle (other than the quick attempt) hold the swept rows.
+//! bound on `U_max` ends the search); and which of the plans is the plan. Unless the case sets
+//! `swept_clearance`, the attempts after one whose plans all tunnel through an obstacle (other
+//! than the quick attempt) hold the swept rows.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};

@@ -116,6 +116,26 @@ fn suite_planar_plan_with(
     (p, r)
 }
 
+/// The plan of `r` verified independently of the planner's grid: on 801 values of k and 1024
+/// intervals in s.
+fn on_a_finer_grid(
+    p: &dlo_planner::planner::Planner,
+    r: &dlo_planner::planner::PlanResult,
+) -> dlo_planner::planner::verify::Verification {
+    use dlo_planner::planner::verify::{fine_model, verify_with};
+    let fine = fine_model(&p.base.model, 1024, 4);
+    let path = p.with_terms(r.path_terms).path();
+    verify_with(
+        &fine,
+        &path,
+        &r.z,
+        801,
+        &p.obstacles,
+        p.base.objective,
+        false,
+    )
+}
+
 /// The suite's planar problem `planar_1_25` (seed 1), planned with the defaults: the quick
 /// attempt's plan peaks at an end shape and coincides with its replay, so it is the plan and
 /// the case's own attempt does not run. Checked independently of the planner's grid: on 801
@@ -126,7 +146,6 @@ fn suite_planar_plan_with(
 #[test]
 fn a_quick_plan_at_the_lower_bound_ends_the_search() {
     use dlo_planner::planner::Attempt;
-    use dlo_planner::planner::verify::{fine_model, verify_with};
     let (p, r) = suite_planar_plan(25);
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick]);
@@ -134,19 +153,8 @@ fn a_quick_plan_at_the_lower_bound_ends_the_search() {
     assert_eq!(r.chosen_start, Some(0));
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= r.replay.tolerance);
-    let model = &p.base.model;
-    let l = model.rod.length;
-    let fine = fine_model(model, 1024, 4);
-    let path = p.with_terms(r.path_terms).path();
-    let v = verify_with(
-        &fine,
-        &path,
-        &r.z,
-        801,
-        &p.obstacles,
-        p.base.objective,
-        false,
-    );
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
     let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
     assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
     assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
@@ -195,7 +203,6 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
 /// `"swept_clearance": false`, every attempt tunnelled and the plan was a collision.)
 #[test]
 fn attempts_after_one_that_tunnels_hold_the_swept_rows() {
-    use dlo_planner::planner::verify::{fine_model, verify_with};
     let (p, r) = suite_planar_plan_of(13, 14);
     let own = &r.starts[0];
     assert!(!own.swept_clearance && !own.collision_free, "{own:?}");
@@ -211,19 +218,8 @@ fn attempts_after_one_that_tunnels_hold_the_swept_rows() {
     assert!(chosen.start > own.start);
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= r.replay.tolerance);
-    let model = &p.base.model;
-    let l = model.rod.length;
-    let fine = fine_model(model, 1024, 4);
-    let path = p.with_terms(r.path_terms).path();
-    let v = verify_with(
-        &fine,
-        &path,
-        &r.z,
-        801,
-        &p.obstacles,
-        p.base.objective,
-        false,
-    );
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
     let clearance = v.min_clearance.expect("an obstacle");
     assert!(clearance >= -1e-6 * l, "clearance {clearance}");
     // The finer grid holds the report's grid values, and finds the peak between them.
