@@ -153,6 +153,8 @@ impl Planner {
         // BFGS's inverse-Hessian approximation (empty: a scaled identity).
         let mut hinv = Vec::new();
         let mut rho = al.rho_initial;
+        // A quick start's samples peak at an end shape at the current `z`, where measured.
+        let mut at_end = None;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(first_stage) {
             if self.over_budget(tally.evaluations) {
                 tally.status = AlStatus::IterationLimit;
@@ -215,6 +217,7 @@ impl Planner {
                     },
                 )
             };
+            at_end = None;
             if carry {
                 rho = out.rho.max(al.rho_initial);
             }
@@ -226,17 +229,19 @@ impl Planner {
             // sharper stages could only move its interior below that peak.
             if self.quick && tally.status == AlStatus::Converged {
                 crate::optim::Nlp::values(&mut p, &z, &mut c);
-                if p.peaks_at_an_end() {
+                at_end = Some(p.peaks_at_an_end());
+                if at_end == Some(true) {
                     break;
                 }
             }
         }
         // A quick plan counts only where it attains the lower bound: one whose samples peak
         // inside the path is left as the stages made it (no tracking, no sample refinement).
-        let settled = !self.quick || {
-            crate::optim::Nlp::values(&mut p, &z, &mut c);
-            p.peaks_at_an_end()
-        };
+        let settled = !self.quick
+            || at_end.unwrap_or_else(|| {
+                crate::optim::Nlp::values(&mut p, &z, &mut c);
+                p.peaks_at_an_end()
+            });
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
         // produces (see the README for why the paper's objective alone does not).
         let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if settled

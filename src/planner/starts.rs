@@ -91,11 +91,10 @@ impl Planner {
         p
     }
 
-    /// The planner of the quick attempt ([`Attempt::Quick`]), with an evaluation budget.
+    /// The planner of the quick attempt ([`Attempt::Quick`]), the same settings otherwise.
     fn quick(&self) -> Planner {
         let mut p = self.clone();
         p.quick = true;
-        p.budget = Some(self.settings.fallback_evaluations);
         p
     }
 
@@ -166,7 +165,7 @@ impl Planner {
             Cow::Owned(p)
         };
         let attempts = (!spatial && self.settings.quick_attempt)
-            .then(|| (Attempt::Quick, Cow::Owned(self.quick())))
+            .then(|| (Attempt::Quick, budget(self.quick())))
             .into_iter()
             .chain(std::iter::once((Attempt::Own, Cow::Borrowed(self))))
             .chain(
