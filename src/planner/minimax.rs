@@ -159,6 +159,11 @@ impl MinimaxProblem {
         self.workers = workers;
     }
 
+    /// The threads the samples are split over.
+    pub(crate) fn workers(&self) -> &Workers {
+        &self.workers
+    }
+
     /// Rows per interior sample.
     pub fn rows_per_sample(&self) -> usize {
         *self.offsets.last().unwrap()

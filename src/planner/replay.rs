@@ -10,6 +10,7 @@
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
 use crate::planner::path::DeformationPath;
+use crate::planner::workers::{JOB_EQUILIBRIA, Workers};
 use crate::rod::kinematics::Shape;
 use crate::statics::problem::StaticProblem;
 use crate::statics::{SolveStatus, StaticOptions, StaticSolution, solve_static_warm};
@@ -397,8 +398,9 @@ pub fn replay(
 }
 
 /// Equilibria the controlled end's poses along `path(z)` produce at `ks` (increasing, from 0):
-/// one warm-started static solve per `k`, without refinement. Returns the boundary positions
-/// (dimensionless) of each, for the planner's tracking term.
+/// one warm-started static solve per `k`, without refinement, marching along `k` from
+/// `start`. Returns each one's boundary positions (dimensionless), for the planner's tracking
+/// term, and its solution.
 pub fn equilibria(
     base: &StaticProblem,
     start: &StaticSolution,
@@ -406,23 +408,81 @@ pub fn equilibria(
     z: &[f64],
     ks: &[f64],
     static_opts: &StaticOptions,
-) -> Vec<Vec<[f64; 3]>> {
-    let model = &base.model;
-    let opts = StaticOptions {
-        stability: false,
-        ..*static_opts
-    };
+) -> Vec<(Vec<[f64; 3]>, StaticSolution)> {
+    let opts = tracking_options(static_opts);
     let mut a = vec![0.0; path.n()];
     let mut shape = Shape::default();
     let mut prev = start.clone();
     ks.iter()
         .map(|&k| {
-            path.shape_at(z, k, &mut a);
-            model.evaluate_into(&a, &mut shape);
-            let (_, sol) = solve_held(base, &prev, &a, &shape.positions, &opts);
-            let x = model.evaluate(&sol.a).positions;
-            prev = sol;
-            x
+            let e = equilibrium_at(base, &prev, path, z, k, &opts, &mut a, &mut shape);
+            prev = e.1.clone();
+            e
         })
         .collect()
+}
+
+/// Stretches of `k` that [`equilibria_from`] marches along side by side: fixed, so that the
+/// targets are the same on any number of threads.
+pub const STRETCHES: usize = 2;
+
+/// [`equilibria`] for a path that has moved a little since `from` (the equilibria an earlier
+/// round found at the same `ks`): the samples are cut into [`STRETCHES`] stretches, the first
+/// marched from `start` as [`equilibria`] does, each other from `from`'s solution at its first
+/// `k`, and `workers` share the stretches out.
+#[allow(clippy::too_many_arguments)]
+pub fn equilibria_from(
+    base: &StaticProblem,
+    start: &StaticSolution,
+    from: &[StaticSolution],
+    path: &DeformationPath,
+    z: &[f64],
+    ks: &[f64],
+    static_opts: &StaticOptions,
+    workers: &Workers,
+) -> Vec<(Vec<[f64; 3]>, StaticSolution)> {
+    debug_assert_eq!(from.len(), ks.len());
+    let opts = tracking_options(static_opts);
+    let n = ks.len();
+    let mut stretches: Vec<Vec<(Vec<[f64; 3]>, StaticSolution)>> = vec![Vec::new(); STRETCHES];
+    workers.for_each_chunk(JOB_EQUILIBRIA, &mut stretches, |i, out| {
+        let (j0, j1) = (i * n / STRETCHES, (i + 1) * n / STRETCHES);
+        let mut a = vec![0.0; path.n()];
+        let mut shape = Shape::default();
+        let mut prev = if i == 0 { start } else { &from[j0] }.clone();
+        for &k in &ks[j0..j1] {
+            let e = equilibrium_at(base, &prev, path, z, k, &opts, &mut a, &mut shape);
+            prev = e.1.clone();
+            out[0].push(e);
+        }
+    });
+    stretches.into_iter().flatten().collect()
+}
+
+/// The static options of tracking's solves: no stability judgement.
+fn tracking_options(static_opts: &StaticOptions) -> StaticOptions {
+    StaticOptions {
+        stability: false,
+        ..*static_opts
+    }
+}
+
+/// The equilibrium the end pose of `path(z)` at `k` produces, solved from `from`: its boundary
+/// positions (dimensionless) and its solution (`a` and `shape` are scratch space).
+#[allow(clippy::too_many_arguments)]
+fn equilibrium_at(
+    base: &StaticProblem,
+    from: &StaticSolution,
+    path: &DeformationPath,
+    z: &[f64],
+    k: f64,
+    opts: &StaticOptions,
+    a: &mut [f64],
+    shape: &mut Shape,
+) -> (Vec<[f64; 3]>, StaticSolution) {
+    let model = &base.model;
+    path.shape_at(z, k, a);
+    model.evaluate_into(a, shape);
+    let (_, sol) = solve_held(base, from, a, &shape.positions, opts);
+    (model.evaluate(&sol.a).positions, sol)
 }

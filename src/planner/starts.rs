@@ -12,7 +12,7 @@
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
 use super::result::Attempt;
-use super::start::Verified;
+use super::start::{Resume, Verified};
 use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
@@ -259,7 +259,8 @@ impl Planner {
                 self.poll(observer);
             };
             let (i, z0) = starts[0].clone();
-            let run = self.optimise_from(i, z0, uniform, 0, &self.workers, &mut sink);
+            let run =
+                self.optimise_from(i, z0, uniform, Resume::default(), &self.workers, &mut sink);
             vec![self.refine(i, run, uniform, check, &self.workers, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
@@ -289,8 +290,14 @@ impl Planner {
                                     let (i, z0) = starts[j].clone();
                                     // The starts already share the cores.
                                     let one = super::workers::Workers::serial();
-                                    let run =
-                                        self.optimise_from(i, z0, uniform, 0, &one, &mut sink);
+                                    let run = self.optimise_from(
+                                        i,
+                                        z0,
+                                        uniform,
+                                        Resume::default(),
+                                        &one,
+                                        &mut sink,
+                                    );
                                     (j, self.refine(i, run, uniform, check, &one, &mut sink))
                                 })
                                 .collect::<Vec<_>>()

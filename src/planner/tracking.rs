@@ -55,22 +55,41 @@ impl Planner {
         // The path before the last round, with its tally: a round that leaves the samples
         // farther from their equilibria is undone.
         let mut before: Option<(Vec<f64>, Tally)> = None;
-        // The equilibria the samples' end poses produce, replayed along the samples.
-        let equilibria = |p: &MinimaxProblem, z: &[f64]| {
-            replay::equilibria(
-                &inflated,
-                &self.start,
-                &p.path,
-                z,
-                &p.ks,
-                &self.static_options,
-            )
+        // The equilibria the samples' end poses produce: the first round's replayed along the
+        // samples, each later round's along stretches of them side by side, each stretch
+        // started from the round before's equilibrium at its first `k` (the path has moved a
+        // little), shared out over the optimiser's threads.
+        let mut solved: Option<Vec<crate::statics::StaticSolution>> = None;
+        let mut equilibria = |p: &MinimaxProblem, z: &[f64]| {
+            let found = match &solved {
+                None => replay::equilibria(
+                    &inflated,
+                    &self.start,
+                    &p.path,
+                    z,
+                    &p.ks,
+                    &self.static_options,
+                ),
+                Some(from) => replay::equilibria_from(
+                    &inflated,
+                    &self.start,
+                    from,
+                    &p.path,
+                    z,
+                    &p.ks,
+                    &self.static_options,
+                    p.workers(),
+                ),
+            };
+            let (positions, sols) = found.into_iter().unzip();
+            solved = Some(sols);
+            positions
         };
         for _ in 0..self.settings.equilibrium_rounds {
             if self.stopped() || self.over_budget(tally.evaluations) {
                 break;
             }
-            let targets = equilibria(p, z);
+            let targets: Vec<Vec<[f64; 3]>> = equilibria(p, z);
             let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
                 old.iter()
                     .zip(&targets)

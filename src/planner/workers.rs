@@ -32,8 +32,12 @@ pub const JOB_GRADIENT: usize = 1;
 pub const JOB_HESSIAN: usize = 2;
 /// See [`JOB_VALUES`].
 pub const JOB_VERIFY: usize = 3;
-/// How many kinds of job there are.
+/// How many kinds of job choose by their cost.
 pub const KINDS: usize = JOB_VERIFY + 1;
+/// Equilibrium tracking's stretches of static solves ([`super::replay::equilibria_from`]):
+/// each element is milliseconds of work, a chunk of its own, and the job runs shared whenever
+/// there are helpers.
+pub const JOB_EQUILIBRIA: usize = KINDS;
 
 /// Whether a kind of job runs shared or on the calling thread alone, by what each has cost
 /// lately. Sharing costs a hand-over, and a helper that looks for work slows a calling thread
@@ -268,7 +272,7 @@ impl Workers {
 
     /// [`Workers::for_each_chunk`] on the same chunks of three slices of the same length.
     /// `kind` (below [`KINDS`]) names the job, whose calls run shared or alone by what they
-    /// have cost each way.
+    /// have cost each way; [`JOB_EQUILIBRIA`] always runs shared, each element a chunk.
     pub fn for_each_chunk3<A: Send, B: Send, C: Send>(
         &self,
         kind: usize,
@@ -280,15 +284,21 @@ impl Workers {
         debug_assert!(a.len() == b.len() && a.len() == c.len());
         // The team runs one job at a time: a clone of these workers used on another thread
         // meanwhile runs its chunks alone.
-        let team = self.team.as_ref().filter(|_| a.len() > CHUNK);
+        let large = kind == JOB_EQUILIBRIA;
+        let size = if large { 1 } else { CHUNK };
+        let team = self.team.as_ref().filter(|_| a.len() > size);
         let mut busy = team.and_then(|t| t.busy.try_lock().ok());
-        let choice = busy.as_mut().map(|b| &mut b[kind.min(KINDS - 1)]);
-        let shared = choice.as_ref().is_some_and(|c| c.shared_next());
+        let large = large && busy.is_some();
+        let choice = busy
+            .as_mut()
+            .filter(|_| !large)
+            .map(|b| &mut b[kind.min(KINDS - 1)]);
+        let shared = large || choice.as_ref().is_some_and(|c| c.shared_next());
         let t0 = Instant::now();
         let (Some(team), true) = (team, shared) else {
-            let chunks = a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK));
-            for (i, ((x, y), z)) in chunks.zip(c.chunks_mut(CHUNK)).enumerate() {
-                f(i * CHUNK, x, y, z);
+            let chunks = a.chunks_mut(size).zip(b.chunks_mut(size));
+            for (i, ((x, y), z)) in chunks.zip(c.chunks_mut(size)).enumerate() {
+                f(i * size, x, y, z);
             }
             if let Some(choice) = choice {
                 choice.record(false, t0.elapsed().as_nanos() as f64);
@@ -297,9 +307,9 @@ impl Workers {
         };
         type Piece<'a, A, B, C> = Mutex<Option<((&'a mut [A], &'a mut [B]), &'a mut [C])>>;
         let pieces: Vec<Piece<A, B, C>> = a
-            .chunks_mut(CHUNK)
-            .zip(b.chunks_mut(CHUNK))
-            .zip(c.chunks_mut(CHUNK))
+            .chunks_mut(size)
+            .zip(b.chunks_mut(size))
+            .zip(c.chunks_mut(size))
             .map(|p| Mutex::new(Some(p)))
             .collect();
         // Thread `t` of `n` takes its own share of the chunks first (the same share at every
@@ -310,7 +320,7 @@ impl Workers {
             for i in own.chain(0..pieces.len()) {
                 let taken = pieces[i].lock().map(|mut p| p.take());
                 if let Ok(Some(((x, y), z))) = taken {
-                    f(i * CHUNK, x, y, z);
+                    f(i * size, x, y, z);
                 }
             }
         };
@@ -342,6 +352,22 @@ mod tests {
                 });
                 assert_eq!(a, (0..n).collect::<Vec<_>>(), "threads {threads}, n {n}");
                 assert!(b.iter().all(|&v| v == 1) && c.iter().all(|&v| v == 2));
+            }
+        }
+    }
+
+    #[test]
+    fn equilibrium_jobs_run_each_element_as_a_chunk_of_its_own() {
+        for threads in [1, 2, 3] {
+            let w = Workers::new(threads);
+            for n in [0, 1, 2, 5] {
+                let mut a: Vec<Vec<usize>> = vec![Vec::new(); n];
+                w.for_each_chunk(JOB_EQUILIBRIA, &mut a, |j0, x| {
+                    assert_eq!(x.len(), 1);
+                    x[0].push(j0);
+                });
+                let want: Vec<Vec<usize>> = (0..n).map(|j| vec![j]).collect();
+                assert_eq!(a, want, "threads {threads}, n {n}");
             }
         }
     }
