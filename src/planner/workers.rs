@@ -57,10 +57,16 @@ impl Choice {
     const PROBE: u64 = 4;
     const REPROBE: u64 = 32;
 
+    /// A call that takes this long alone (ns) is worth sharing whatever a hand-over costs:
+    /// ten times the wake-up of a sleeping helper.
+    const LARGE: f64 = 1e6;
+
     fn shared_next(&self) -> bool {
         let c = self.calls;
         if c < 2 * Self::PROBE {
-            return c >= Self::PROBE;
+            // A job too large for a hand-over to matter (a verification grid, a few calls per
+            // plan) stops probing alone after its first call.
+            return c >= Self::PROBE || (c >= 1 && self.alone >= Self::LARGE);
         }
         let better = self.shared < self.alone;
         if c.is_multiple_of(Self::REPROBE) {
@@ -434,5 +440,24 @@ mod tests {
                     .count()
             );
         }
+    }
+
+    #[test]
+    fn a_job_that_takes_over_a_millisecond_alone_shares_from_its_second_call() {
+        let mut c = Choice::default();
+        let mut ways = Vec::new();
+        for _ in 0..3 {
+            let s = c.shared_next();
+            ways.push(s);
+            c.record(
+                s,
+                if s {
+                    0.6 * Choice::LARGE
+                } else {
+                    Choice::LARGE
+                },
+            );
+        }
+        assert_eq!(ways, [false, true, true]);
     }
 }

@@ -1884,7 +1884,16 @@ fn tracking_stretches_reach_the_marched_equilibria() {
     let marched = equilibria(&p.base, &p.start, &path, &r.z, &ks, &p.static_options);
     let from: Vec<_> = marched.iter().map(|(_, s)| s.clone()).collect();
     let stretched = |w: &Workers| {
-        equilibria_from(&p.base, &p.start, &from, &path, &r.z, &ks, &p.static_options, w)
+        equilibria_from(
+            &p.base,
+            &p.start,
+            &from,
+            &path,
+            &r.z,
+            &ks,
+            &p.static_options,
+            w,
+        )
     };
     let one = stretched(&Workers::serial());
     let two = stretched(&Workers::new(2));
