@@ -47,9 +47,12 @@ pub const JOB_EQUILIBRIA: usize = KINDS;
 #[derive(Clone, Copy, Debug, Default)]
 struct Choice {
     calls: u64,
-    /// Moving averages of a call's wall time (ns): alone, shared.
+    /// Moving averages of a call's wall time (ns): alone, shared (0: not measured yet).
     alone: f64,
     shared: f64,
+    /// Whether the probes start shared: for a kind whose calls are large from the first (the
+    /// verification grid, [`JOB_VERIFY`]).
+    shared_first: bool,
 }
 
 impl Choice {
@@ -57,18 +60,30 @@ impl Choice {
     const PROBE: u64 = 4;
     const REPROBE: u64 = 32;
 
-    /// A call that takes this long alone (ns) is worth sharing whatever a hand-over costs:
-    /// ten times the wake-up of a sleeping helper.
+    /// A call that takes this long (ns) is worth sharing whatever a hand-over costs: ten times
+    /// the wake-up of a sleeping helper.
     const LARGE: f64 = 1e6;
+
+    /// The choice of a kind of job: its probes start shared for [`JOB_VERIFY`].
+    fn of(kind: usize) -> Choice {
+        Choice {
+            shared_first: kind == JOB_VERIFY,
+            ..Choice::default()
+        }
+    }
 
     fn shared_next(&self) -> bool {
         let c = self.calls;
         if c < 2 * Self::PROBE {
             // A job too large for a hand-over to matter (a verification grid, a few calls per
-            // plan) stops probing alone after its first call.
-            return c >= Self::PROBE || (c >= 1 && self.alone >= Self::LARGE);
+            // plan) runs shared from its second call, whichever way it was probed first.
+            if c >= 1 && self.alone.max(self.shared) >= Self::LARGE {
+                return true;
+            }
+            return (c >= Self::PROBE) != self.shared_first;
         }
-        let better = self.shared < self.alone;
+        let cost = |v: f64| if v > 0.0 { v } else { f64::INFINITY };
+        let better = cost(self.shared) < cost(self.alone);
         if c.is_multiple_of(Self::REPROBE) {
             !better
         } else {
@@ -214,7 +229,7 @@ impl Workers {
         }
         Workers {
             team: Some(Arc::new(Team {
-                busy: Mutex::new([Choice::default(); KINDS]),
+                busy: Mutex::new(std::array::from_fn(Choice::of)),
                 shared,
                 helpers,
             })),
@@ -459,5 +474,23 @@ mod tests {
             );
         }
         assert_eq!(ways, [false, true, true]);
+    }
+
+    #[test]
+    fn the_verification_probes_shared_first_and_a_large_job_stays_shared() {
+        for (cost, want) in [
+            (2.0 * Choice::LARGE, [true, true, true, true, true, true]),
+            (0.1 * Choice::LARGE, [true, true, true, true, false, false]),
+        ] {
+            let mut c = Choice::of(JOB_VERIFY);
+            let mut ways = Vec::new();
+            for _ in 0..6 {
+                let s = c.shared_next();
+                ways.push(s);
+                c.record(s, cost);
+            }
+            assert_eq!(ways, want, "cost {cost}");
+        }
+        assert!(!Choice::of(JOB_VALUES).shared_next());
     }
 }
