@@ -64,8 +64,8 @@ pub(super) struct StartRun {
     /// False for a quick start whose samples peak inside the path after its stages: it cannot
     /// end the search, so it was neither tracked nor is it refined.
     pub(super) settled: bool,
-    /// BFGS's inverse-Hessian approximation and the penalty the last stage ended with, where
-    /// the stages carry them ([`Planner::stages_carry_curvature`]; empty otherwise).
+    /// A quick start's BFGS inverse-Hessian approximation and penalty as its last stage ended,
+    /// for a refinement's rerun to start from (empty for other starts).
     pub(super) curvature: (Vec<f64>, f64),
 }
 
@@ -291,7 +291,7 @@ impl Planner {
             tracking_rounds_kept,
             equilibrium_deviation,
             settled,
-            curvature: if carry {
+            curvature: if self.quick {
                 (hinv, rho)
             } else {
                 (Vec::new(), 0.0)
@@ -391,11 +391,7 @@ impl Planner {
             // Warm: only the sharpest stage again.
             let last = self.settings.sharpness.len() - 1;
             // A quick start's rerun starts from the curvature and penalty its stages carried.
-            let (curvature, rho) = if self.quick {
-                chosen.curvature.clone()
-            } else {
-                (Vec::new(), 0.0)
-            };
+            let (curvature, rho) = chosen.curvature.clone();
             let from = Resume {
                 stage: last,
                 curvature,
