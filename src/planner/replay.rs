@@ -409,17 +409,7 @@ pub fn equilibria(
     ks: &[f64],
     static_opts: &StaticOptions,
 ) -> Vec<(Vec<[f64; 3]>, StaticSolution)> {
-    let opts = tracking_options(static_opts);
-    let mut a = vec![0.0; path.n()];
-    let mut shape = Shape::default();
-    let mut prev = start.clone();
-    ks.iter()
-        .map(|&k| {
-            let e = equilibrium_at(base, &prev, path, z, k, &opts, &mut a, &mut shape);
-            prev = e.1.clone();
-            e
-        })
-        .collect()
+    march(base, start, path, z, ks, &tracking_options(static_opts))
 }
 
 /// Stretches of `k` that [`equilibria_from`] marches along side by side: fixed, so that the
@@ -447,14 +437,8 @@ pub fn equilibria_from(
     let mut stretches: Vec<Vec<(Vec<[f64; 3]>, StaticSolution)>> = vec![Vec::new(); STRETCHES];
     workers.for_each_chunk(JOB_EQUILIBRIA, &mut stretches, |i, out| {
         let (j0, j1) = (i * n / STRETCHES, (i + 1) * n / STRETCHES);
-        let mut a = vec![0.0; path.n()];
-        let mut shape = Shape::default();
-        let mut prev = if i == 0 { start } else { &from[j0] }.clone();
-        for &k in &ks[j0..j1] {
-            let e = equilibrium_at(base, &prev, path, z, k, &opts, &mut a, &mut shape);
-            prev = e.1.clone();
-            out[0].push(e);
-        }
+        let first = if i == 0 { start } else { &from[j0] };
+        out[0] = march(base, first, path, z, &ks[j0..j1], &opts);
     });
     stretches.into_iter().flatten().collect()
 }
@@ -467,22 +451,26 @@ fn tracking_options(static_opts: &StaticOptions) -> StaticOptions {
     }
 }
 
-/// The equilibrium the end pose of `path(z)` at `k` produces, solved from `from`: its boundary
-/// positions (dimensionless) and its solution (`a` and `shape` are scratch space).
-#[allow(clippy::too_many_arguments)]
-fn equilibrium_at(
+/// The equilibria the end poses of `path(z)` at `ks` produce, each solved from the one before
+/// (the first from `first`), with their boundary positions (dimensionless).
+fn march(
     base: &StaticProblem,
-    from: &StaticSolution,
+    first: &StaticSolution,
     path: &DeformationPath,
     z: &[f64],
-    k: f64,
+    ks: &[f64],
     opts: &StaticOptions,
-    a: &mut [f64],
-    shape: &mut Shape,
-) -> (Vec<[f64; 3]>, StaticSolution) {
+) -> Vec<(Vec<[f64; 3]>, StaticSolution)> {
     let model = &base.model;
-    path.shape_at(z, k, a);
-    model.evaluate_into(a, shape);
-    let (_, sol) = solve_held(base, from, a, &shape.positions, opts);
-    (model.evaluate(&sol.a).positions, sol)
+    let mut a = vec![0.0; path.n()];
+    let mut shape = Shape::default();
+    let mut out: Vec<(Vec<[f64; 3]>, StaticSolution)> = Vec::with_capacity(ks.len());
+    for &k in ks {
+        path.shape_at(z, k, &mut a);
+        model.evaluate_into(&a, &mut shape);
+        let from = out.last().map_or(first, |(_, sol)| sol);
+        let (_, sol) = solve_held(base, from, &a, &shape.positions, opts);
+        out.push((model.evaluate(&sol.a).positions, sol));
+    }
+    out
 }

@@ -38,15 +38,20 @@ impl Tally {
     }
 }
 
+/// BFGS's inverse-Hessian approximation and the penalty a sharpness stage ended with (an empty
+/// `hinv`: a scaled identity and the first stage's penalty).
+#[derive(Clone, Default)]
+pub(super) struct Curvature {
+    pub(super) hinv: Vec<f64>,
+    pub(super) rho: f64,
+}
+
 /// Where a start's sharpness stages begin: at stage `stage`, and, where the stages carry the
-/// curvature ([`Planner::stages_carry_curvature`]), from BFGS's inverse-Hessian approximation
-/// `curvature` and the penalty `rho` (an empty `curvature`: a scaled identity and the first
-/// stage's penalty).
+/// curvature ([`Planner::stages_carry_curvature`]), from `curvature`.
 #[derive(Clone, Default)]
 pub(super) struct Resume {
     pub(super) stage: usize,
-    pub(super) curvature: Vec<f64>,
-    pub(super) rho: f64,
+    pub(super) curvature: Curvature,
 }
 
 #[derive(Clone)]
@@ -66,7 +71,7 @@ pub(super) struct StartRun {
     pub(super) settled: bool,
     /// A quick start's BFGS inverse-Hessian approximation and penalty as its last stage ended,
     /// for a refinement's rerun to start from (empty for other starts).
-    pub(super) curvature: (Vec<f64>, f64),
+    pub(super) curvature: Curvature,
 }
 
 impl StartRun {
@@ -85,7 +90,7 @@ impl StartRun {
             tracking_rounds_kept: 0,
             equilibrium_deviation: None,
             settled: true,
-            curvature: (Vec::new(), 0.0),
+            curvature: Curvature::default(),
         }
     }
 }
@@ -169,8 +174,8 @@ impl Planner {
         let mut z = z0;
         let carry = self.stages_carry_curvature();
         // BFGS's inverse-Hessian approximation (empty: a scaled identity), and the penalty.
-        let (mut hinv, mut rho) = if carry && !from.curvature.is_empty() {
-            (from.curvature, from.rho)
+        let (mut hinv, mut rho) = if carry && !from.curvature.hinv.is_empty() {
+            (from.curvature.hinv, from.curvature.rho)
         } else {
             (Vec::new(), al.rho_initial)
         };
@@ -292,9 +297,9 @@ impl Planner {
             equilibrium_deviation,
             settled,
             curvature: if self.quick {
-                (hinv, rho)
+                Curvature { hinv, rho }
             } else {
-                (Vec::new(), 0.0)
+                Curvature::default()
             },
         }
     }
@@ -391,11 +396,9 @@ impl Planner {
             // Warm: only the sharpest stage again.
             let last = self.settings.sharpness.len() - 1;
             // A quick start's rerun starts from the curvature and penalty its stages carried.
-            let (curvature, rho) = chosen.curvature.clone();
             let from = Resume {
                 stage: last,
-                curvature,
-                rho,
+                curvature: chosen.curvature.clone(),
             };
             let r = self.optimise_from(start, chosen.z.clone(), &ks, from, workers, sink);
             chosen = StartRun {

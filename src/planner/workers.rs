@@ -23,8 +23,10 @@ const SPIN: Duration = Duration::from_micros(100);
 
 /// The kinds of job the planner tells apart ([`Workers::for_each_chunk3`]'s `kind`), each run
 /// shared or alone by what its own calls cost: the path optimisation's sampled values,
-/// gradients and Hessians ([`super::minimax::MinimaxProblem`]), and the verification's shapes
-/// ([`super::verify`]).
+/// gradients and Hessians ([`super::minimax::MinimaxProblem`]), the verification's shapes
+/// ([`super::verify`]), and equilibrium tracking's stretches of static solves
+/// ([`super::replay::equilibria_from`], each element milliseconds of work and a chunk of its
+/// own).
 pub const JOB_VALUES: usize = 0;
 /// See [`JOB_VALUES`].
 pub const JOB_GRADIENT: usize = 1;
@@ -32,12 +34,10 @@ pub const JOB_GRADIENT: usize = 1;
 pub const JOB_HESSIAN: usize = 2;
 /// See [`JOB_VALUES`].
 pub const JOB_VERIFY: usize = 3;
-/// How many kinds of job choose by their cost.
-pub const KINDS: usize = JOB_VERIFY + 1;
-/// Equilibrium tracking's stretches of static solves ([`super::replay::equilibria_from`]):
-/// each element is milliseconds of work, a chunk of its own, and the job runs shared whenever
-/// there are helpers.
-pub const JOB_EQUILIBRIA: usize = KINDS;
+/// See [`JOB_VALUES`].
+pub const JOB_EQUILIBRIA: usize = 4;
+/// How many kinds of job there are.
+pub const KINDS: usize = JOB_EQUILIBRIA + 1;
 
 /// Whether a kind of job runs shared or on the calling thread alone, by what each has cost
 /// lately. Sharing costs a hand-over, and a helper that looks for work slows a calling thread
@@ -50,8 +50,8 @@ struct Choice {
     /// Moving averages of a call's wall time (ns): alone, shared (0: not measured yet).
     alone: f64,
     shared: f64,
-    /// Whether the probes start shared: for a kind whose calls are large from the first (the
-    /// verification grid, [`JOB_VERIFY`]).
+    /// Whether the probes start shared: for the kinds whose calls are large from the first
+    /// (the verification grid, [`JOB_VERIFY`], and tracking's equilibria, [`JOB_EQUILIBRIA`]).
     shared_first: bool,
 }
 
@@ -64,10 +64,11 @@ impl Choice {
     /// the wake-up of a sleeping helper.
     const LARGE: f64 = 1e6;
 
-    /// The choice of a kind of job: its probes start shared for [`JOB_VERIFY`].
+    /// The choice of a kind of job: its probes start shared for [`JOB_VERIFY`] and
+    /// [`JOB_EQUILIBRIA`].
     fn of(kind: usize) -> Choice {
         Choice {
-            shared_first: kind == JOB_VERIFY,
+            shared_first: kind == JOB_VERIFY || kind == JOB_EQUILIBRIA,
             ..Choice::default()
         }
     }
@@ -293,7 +294,7 @@ impl Workers {
 
     /// [`Workers::for_each_chunk`] on the same chunks of three slices of the same length.
     /// `kind` (below [`KINDS`]) names the job, whose calls run shared or alone by what they
-    /// have cost each way; [`JOB_EQUILIBRIA`] always runs shared, each element a chunk.
+    /// have cost each way; a [`JOB_EQUILIBRIA`] job's chunks are single elements.
     pub fn for_each_chunk3<A: Send, B: Send, C: Send>(
         &self,
         kind: usize,
@@ -305,16 +306,11 @@ impl Workers {
         debug_assert!(a.len() == b.len() && a.len() == c.len());
         // The team runs one job at a time: a clone of these workers used on another thread
         // meanwhile runs its chunks alone.
-        let large = kind == JOB_EQUILIBRIA;
-        let size = if large { 1 } else { CHUNK };
+        let size = if kind == JOB_EQUILIBRIA { 1 } else { CHUNK };
         let team = self.team.as_ref().filter(|_| a.len() > size);
         let mut busy = team.and_then(|t| t.busy.try_lock().ok());
-        let large = large && busy.is_some();
-        let choice = busy
-            .as_mut()
-            .filter(|_| !large)
-            .map(|b| &mut b[kind.min(KINDS - 1)]);
-        let shared = large || choice.as_ref().is_some_and(|c| c.shared_next());
+        let choice = busy.as_mut().map(|b| &mut b[kind.min(KINDS - 1)]);
+        let shared = choice.as_ref().is_some_and(|c| c.shared_next());
         let t0 = Instant::now();
         let (Some(team), true) = (team, shared) else {
             let chunks = a.chunks_mut(size).zip(b.chunks_mut(size));
