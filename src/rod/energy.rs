@@ -100,6 +100,12 @@ impl Model {
         let up = self.up();
         // The node sums below, unless the quadratic form has already given them.
         let nodes = if quadratic { 0 } else { self.nodes() };
+        // A planar, inextensible rod in the case's axes: the same sums without the zero terms.
+        let planar = !spatial && oe.is_none() && up.is_none() && !self.de_lanes.is_empty();
+        if planar && nodes > 0 {
+            self.planar_node_terms(shape, &mut t, grad.as_deref_mut());
+        }
+        let nodes = if planar { 0 } else { nodes };
         let mut factors: Vec<[f64; 6]> = Vec::with_capacity(if grad.is_some() { nodes } else { 0 });
         for q in 0..nodes {
             let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
@@ -145,7 +151,9 @@ impl Model {
             let g_dph = wf * dph * st * st + wt * omega * ct;
             factors.push([g_th, g_dth, grav_ph, g_dph, wt * omega, we * eps + grav_e]);
         }
-        if let Some(g) = grad.as_deref_mut() {
+        if let Some(g) = grad.as_deref_mut()
+            && nodes > 0
+        {
             self.add_node_sums(&factors, g);
         }
         let base = self.base_position(a);
@@ -173,6 +181,60 @@ impl Model {
             }
         }
         t
+    }
+
+    /// The node sums of a planar, inextensible rod in the case's axes (`φ = ψ = ε = 0`, so
+    /// `cos φ = 1 + ε = 1`): flexure `½ wf θ'²` and gravity `wg sin θ` at each node, and with
+    /// `grad` the sums `Σ_q (wg cos θ e_i + wf θ' e'_i)` added to θ's coefficients. The same
+    /// operations in the same order as the general loop and [`Model::add_node_sums`] (whose
+    /// zero terms add exact zeros), so the same result bit for bit, but every basis function's
+    /// sum advances in one pass over the nodes, in registers.
+    #[inline(always)]
+    fn planar_node_terms(&self, shape: &Shape, t: &mut EnergyTerms, grad: Option<&mut [f64]>) {
+        let nodes = self
+            .wf
+            .iter()
+            .zip(&self.wg)
+            .zip(shape.dth.iter().zip(&shape.sth));
+        let Some(g) = grad else {
+            for ((&wf, &wg), (&dth, &st)) in nodes {
+                t.flexural += 0.5 * wf * (dth * dth);
+                t.gravitational += wg * st;
+            }
+            return;
+        };
+        match self.nb().div_ceil(4) {
+            1 => self.planar_sums::<1>(shape, t, g),
+            2 => self.planar_sums::<2>(shape, t, g),
+            3 => self.planar_sums::<3>(shape, t, g),
+            _ => self.planar_sums::<4>(shape, t, g),
+        }
+    }
+
+    /// [`Model::planar_node_terms`] with its gradient, for at most `4 C` basis functions.
+    #[inline(always)]
+    fn planar_sums<const C: usize>(&self, shape: &Shape, t: &mut EnergyTerms, g: &mut [f64]) {
+        let nb = self.nb();
+        let mut acc = [[0.0; 4]; C];
+        for (i, &gi) in g[..nb].iter().enumerate() {
+            acc[i / 4][i % 4] = gi;
+        }
+        let fields = shape.dth.iter().zip(&shape.sth).zip(&shape.cth);
+        let weights = self.wf.iter().zip(&self.wg);
+        let lanes = self.e_lanes.iter().zip(&self.de_lanes);
+        for (((&wf, &wg), ((&dth, &st), &ct)), (e, de)) in weights.zip(fields).zip(lanes) {
+            t.flexural += 0.5 * wf * (dth * dth);
+            t.gravitational += wg * st;
+            let (f0, f1) = (wg * ct, wf * dth);
+            for (c, acc) in acc.iter_mut().enumerate() {
+                for (l, v) in acc.iter_mut().enumerate() {
+                    *v += f0 * e[4 * c + l] + f1 * de[4 * c + l];
+                }
+            }
+        }
+        for (i, gi) in g[..nb].iter_mut().enumerate() {
+            *gi = acc[i / 4][i % 4];
+        }
     }
 
     /// Flexure and extension of a planar rod without gravity, `½ aᵀ K a` with the constant

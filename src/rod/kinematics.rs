@@ -199,24 +199,57 @@ impl Model {
     }
 
     /// The angle and strain part of [`Model::positions_vjp_body`] for `nb ≤ LANES`: the same
-    /// operations in the same order, with each field's sums in a fixed-size array (registers)
+    /// operations in the same order, with each field's sums in fixed-size arrays (registers)
     /// instead of `grad`, so that a node's additions need not wait for the previous node's
-    /// stores.
+    /// stores. Compiled for each set of fields and for three or four vectors of four sums per
+    /// field, so that only the sums the layout has are kept.
     #[inline(always)]
     fn positions_vjp_lanes(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
+        let angles = self.layout.offset(Field::Phi).is_some();
+        let ext = self.layout.offset(Field::Eps).is_some();
+        match (self.nb() > 12, angles, ext) {
+            (false, false, false) => self.vjp_lanes::<3, false, false>(shape, v, grad),
+            (false, false, true) => self.vjp_lanes::<3, false, true>(shape, v, grad),
+            (false, true, false) => self.vjp_lanes::<3, true, false>(shape, v, grad),
+            (false, true, true) => self.vjp_lanes::<3, true, true>(shape, v, grad),
+            (true, false, false) => self.vjp_lanes::<4, false, false>(shape, v, grad),
+            (true, false, true) => self.vjp_lanes::<4, false, true>(shape, v, grad),
+            (true, true, false) => self.vjp_lanes::<4, true, false>(shape, v, grad),
+            (true, true, true) => self.vjp_lanes::<4, true, true>(shape, v, grad),
+        }
+    }
+
+    /// [`Model::positions_vjp_lanes`] for `nb ≤ 4 C`, with (`ANGLES`) or without the φ field
+    /// and with (`EXT`) or without ε.
+    #[inline(always)]
+    fn vjp_lanes<const C: usize, const ANGLES: bool, const EXT: bool>(
+        &self,
+        shape: &Shape,
+        v: &[[f64; 3]],
+        grad: &mut [f64],
+    ) {
         let nb = self.nb();
-        let ot = 0;
-        let op = self.layout.offset(Field::Phi);
-        let oe = self.layout.offset(Field::Eps);
+        let op = self.layout.offset(Field::Phi).filter(|_| ANGLES);
+        let oe = self.layout.offset(Field::Eps).filter(|_| EXT);
         let ps = &self.mesh.panel_start;
         let load = |o: Option<usize>, grad: &[f64]| {
-            let mut acc = [0.0; LANES];
+            let mut acc = [[0.0; 4]; C];
             if let Some(o) = o {
-                acc[..nb].copy_from_slice(&grad[o..o + nb]);
+                for (i, &gi) in grad[o..o + nb].iter().enumerate() {
+                    acc[i / 4][i % 4] = gi;
+                }
             }
             acc
         };
-        let (mut at, mut ap, mut ae) = (load(Some(ot), grad), load(op, grad), load(oe, grad));
+        let (mut at, mut ap, mut ae) = (load(Some(0), grad), load(op, grad), load(oe, grad));
+        #[inline(always)]
+        fn add<const C: usize>(acc: &mut [[f64; 4]; C], f: f64, e: &[f64; LANES]) {
+            for (c, acc) in acc.iter_mut().enumerate() {
+                for (l, a) in acc.iter_mut().enumerate() {
+                    *a += f * e[4 * c + l];
+                }
+            }
+        }
         let mut suffix = [0.0; 3];
         for j in (0..self.mesh.panels()).rev() {
             let vb = v[j + 1];
@@ -238,26 +271,22 @@ impl Model {
             for ((((((&w, &eps), &st), &ct), &sp), &cp), e) in nodes {
                 let one = 1.0 + eps;
                 let gth = w * one * (suffix[0] * ct * cp + suffix[1] * ct * sp - suffix[2] * st);
-                for (a, &el) in at.iter_mut().zip(e) {
-                    *a += gth * el;
-                }
-                if op.is_some() {
+                add(&mut at, gth, e);
+                if ANGLES {
                     let gph = w * one * (-suffix[0] * st * sp + suffix[1] * st * cp);
-                    for (a, &el) in ap.iter_mut().zip(e) {
-                        *a += gph * el;
-                    }
+                    add(&mut ap, gph, e);
                 }
-                if oe.is_some() {
+                if EXT {
                     let gep = w * (suffix[0] * st * cp + suffix[1] * st * sp + suffix[2] * ct);
-                    for (a, &el) in ae.iter_mut().zip(e) {
-                        *a += gep * el;
-                    }
+                    add(&mut ae, gep, e);
                 }
             }
         }
-        for (o, acc) in [(Some(ot), at), (op, ap), (oe, ae)] {
+        for (o, acc) in [(Some(0), at), (op, ap), (oe, ae)] {
             if let Some(o) = o {
-                grad[o..o + nb].copy_from_slice(&acc[..nb]);
+                for (i, gi) in grad[o..o + nb].iter_mut().enumerate() {
+                    *gi = acc[i / 4][i % 4];
+                }
             }
         }
     }

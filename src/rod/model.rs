@@ -112,6 +112,9 @@ pub struct Model {
     /// Basis values, node-major, each node's padded with zeros to [`LANES`] (empty when
     /// `nb > LANES`): the positions' vector–Jacobian product keeps its sums in registers.
     pub(crate) e_lanes: Vec<[f64; LANES]>,
+    /// Basis derivatives in [`Model::e_lanes`]'s form: a planar rod's energy gradient keeps its
+    /// sums in registers.
+    pub(crate) de_lanes: Vec<[f64; LANES]>,
     /// `w · Rf(t)/Rf`.
     pub(crate) wf: Vec<f64>,
     /// `w · Rt(t)/Rf`.
@@ -182,6 +185,7 @@ impl Model {
             |m: &[f64]| -> Vec<f64> { (0..nb * nn).map(|k| m[(k % nn) * nb + k / nn]).collect() };
         let (e_rows, de_rows) = (transpose(&e), transpose(&de));
         let e_lanes = padded(e.chunks_exact(nb), nb);
+        let de_lanes = padded(de.chunks_exact(nb), nb);
         let gravity_total = rod.weight.integral_from(0.0) * l.powi(3) / rf_ref;
         let load_boundary = loads.iter().map(|ld| mesh.boundary_index(ld.t)).collect();
         let mut model = Model {
@@ -196,6 +200,7 @@ impl Model {
             e_rows,
             de_rows,
             e_lanes,
+            de_lanes,
             wf,
             wt,
             we,
