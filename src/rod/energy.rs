@@ -100,61 +100,36 @@ impl Model {
         let up = self.up();
         // The node sums below, unless the quadratic form has already given them.
         let nodes = if quadratic { 0 } else { self.nodes() };
-        // A planar, inextensible rod in the case's axes: the same sums without the zero terms.
-        let planar = !spatial && oe.is_none() && up.is_none() && !self.de_lanes.is_empty();
-        if planar && nodes > 0 {
-            self.planar_node_terms(shape, &mut t, grad.as_deref_mut());
-        }
-        let nodes = if planar { 0 } else { nodes };
-        let mut factors: Vec<[f64; 6]> = Vec::with_capacity(if grad.is_some() { nodes } else { 0 });
-        for q in 0..nodes {
-            let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
-            let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
-            let one = 1.0 + eps;
-            let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
-            let omega = dph * ct + dps;
-            t.flexural += 0.5 * wf * (dth * dth + dph * dph * st * st);
-            if spatial {
-                t.torsional += 0.5 * wt * omega * omega;
-            }
-            if oe.is_some() {
-                t.extensional += 0.5 * we * eps * eps;
-            }
-            // Gravity `wg (1+ε) h` for the tangent's height `h = ζ·x̂` (`sθcφ` in the case's
-            // axes, `u·ζ` for the vertical `u` of an angles' frame): its value and its θ, φ
-            // and ε derivatives.
-            let (grav, grav_th, grav_ph, grav_e) = match up {
-                None => (
-                    wg * one * st * cp,
-                    wg * one * ct * cp,
-                    -wg * one * st * sp,
-                    wg * st * cp,
-                ),
-                Some(u) => {
-                    let h = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
-                    let h_th = u[0] * ct * cp + u[1] * ct * sp - u[2] * st;
-                    let h_ph = -u[0] * st * sp + u[1] * st * cp;
-                    (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
+        if nodes > 0 {
+            if self.de_lanes.is_empty() {
+                // More than `LANES` basis functions: the factors first, then their sums.
+                let mut factors = Vec::with_capacity(if grad.is_some() { nodes } else { 0 });
+                for q in 0..nodes {
+                    let f = self.node_terms(shape, q, spatial, oe.is_some(), up, &mut t);
+                    if grad.is_some() {
+                        factors.push(f);
+                    }
                 }
-            };
-            t.gravitational += grav;
-            if grad.is_none() {
-                continue;
+                if let Some(g) = grad.as_deref_mut() {
+                    self.add_node_sums(&factors, g);
+                }
+            } else if !spatial && oe.is_none() && up.is_none() {
+                // A planar, inextensible rod in the case's axes: without the zero terms.
+                self.planar_node_terms(shape, &mut t, grad.as_deref_mut());
+            } else {
+                let g = grad.as_deref_mut();
+                let t = &mut t;
+                match (self.nb() > 12, spatial, oe.is_some()) {
+                    (false, false, false) => self.fused_node_sums::<3, false, false>(shape, t, g),
+                    (false, false, true) => self.fused_node_sums::<3, false, true>(shape, t, g),
+                    (false, true, false) => self.fused_node_sums::<3, true, false>(shape, t, g),
+                    (false, true, true) => self.fused_node_sums::<3, true, true>(shape, t, g),
+                    (true, false, false) => self.fused_node_sums::<4, false, false>(shape, t, g),
+                    (true, false, true) => self.fused_node_sums::<4, false, true>(shape, t, g),
+                    (true, true, false) => self.fused_node_sums::<4, true, false>(shape, t, g),
+                    (true, true, true) => self.fused_node_sums::<4, true, true>(shape, t, g),
+                }
             }
-            // The node's factors of the basis rows in the gradient (d/dθ, d/dθ', d/dφ, d/dφ',
-            // d/dψ', d/dε); `add_node_sums` adds them up over the nodes.
-            let mut g_th = grav_th;
-            let g_dth = wf * dth;
-            if spatial {
-                g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
-            }
-            let g_dph = wf * dph * st * st + wt * omega * ct;
-            factors.push([g_th, g_dth, grav_ph, g_dph, wt * omega, we * eps + grav_e]);
-        }
-        if let Some(g) = grad.as_deref_mut()
-            && nodes > 0
-        {
-            self.add_node_sums(&factors, g);
         }
         let base = self.base_position(a);
         t.gravitational += self.gravity_total * base[0];
@@ -181,6 +156,187 @@ impl Model {
             }
         }
         t
+    }
+
+    /// Node `q`'s terms added to `t`, and its factors of the basis rows in the gradient
+    /// (d/dθ, d/dθ', d/dφ, d/dφ', d/dψ', d/dε), which [`Model::add_node_sums`] or
+    /// [`Model::fused_node_sums`] add up over the nodes.
+    #[inline(always)]
+    fn node_terms(
+        &self,
+        shape: &Shape,
+        q: usize,
+        spatial: bool,
+        ext: bool,
+        up: Option<[f64; 3]>,
+        t: &mut EnergyTerms,
+    ) -> [f64; 6] {
+        let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+        let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
+        let one = 1.0 + eps;
+        let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
+        let omega = dph * ct + dps;
+        t.flexural += 0.5 * wf * (dth * dth + dph * dph * st * st);
+        if spatial {
+            t.torsional += 0.5 * wt * omega * omega;
+        }
+        if ext {
+            t.extensional += 0.5 * we * eps * eps;
+        }
+        // Gravity `wg (1+ε) h` for the tangent's height `h = ζ·x̂` (`sθcφ` in the case's
+        // axes, `u·ζ` for the vertical `u` of an angles' frame): its value and its θ, φ
+        // and ε derivatives.
+        let (grav, grav_th, grav_ph, grav_e) = match up {
+            None => (
+                wg * one * st * cp,
+                wg * one * ct * cp,
+                -wg * one * st * sp,
+                wg * st * cp,
+            ),
+            Some(u) => {
+                let h = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
+                let h_th = u[0] * ct * cp + u[1] * ct * sp - u[2] * st;
+                let h_ph = -u[0] * st * sp + u[1] * st * cp;
+                (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
+            }
+        };
+        t.gravitational += grav;
+        let mut g_th = grav_th;
+        let g_dth = wf * dth;
+        if spatial {
+            g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
+        }
+        let g_dph = wf * dph * st * st + wt * omega * ct;
+        [g_th, g_dth, grav_ph, g_dph, wt * omega, we * eps + grav_e]
+    }
+
+    /// The node terms and, with `grad`, their sums for `nb ≤ 4 C` basis functions, with
+    /// (`SPATIAL`) or without the φ and ψ fields and with (`EXT`) or without ε (a planar rod
+    /// here is extensible or has an angles' frame). The same operations in the same order as
+    /// [`Model::node_terms`] and [`Model::add_node_sums`], so the same result bit for bit, but
+    /// a block of nodes at a time: first every node's terms and factors side by side (no node
+    /// waits for another, so the loop runs on vectors), then the energies added up in node
+    /// order, then the factors into sums kept in registers.
+    #[inline(always)]
+    fn fused_node_sums<const C: usize, const SPATIAL: bool, const EXT: bool>(
+        &self,
+        shape: &Shape,
+        t: &mut EnergyTerms,
+        grad: Option<&mut [f64]>,
+    ) {
+        const BLOCK: usize = 32;
+        let up = self.up();
+        let nodes = self.nodes();
+        let lay = &self.layout;
+        let nb = self.nb();
+        let offsets = [
+            Some(0),
+            lay.offset(Field::Phi).filter(|_| SPATIAL),
+            lay.offset(Field::Psi).filter(|_| SPATIAL),
+            lay.offset(Field::Eps).filter(|_| EXT),
+        ];
+        let mut acc = [[[0.0; 4]; C]; 4];
+        if let Some(g) = grad.as_deref() {
+            for (o, acc) in offsets.iter().zip(acc.iter_mut()) {
+                if let Some(o) = *o {
+                    for (i, &gi) in g[o..o + nb].iter().enumerate() {
+                        acc[i / 4][i % 4] = gi;
+                    }
+                }
+            }
+        }
+        let mut start = 0;
+        while start < nodes {
+            let len = (nodes - start).min(BLOCK);
+            let r = start..start + len;
+            // Each node's energies (flexure, torsion, extension, gravity) and factors.
+            let mut en = [[0.0; BLOCK]; 4];
+            let mut f = [[0.0; BLOCK]; 6];
+            let (st, ct) = (&shape.sth[r.clone()], &shape.cth[r.clone()]);
+            let (sp, cp) = (&shape.sph[r.clone()], &shape.cph[r.clone()]);
+            let (dth, dph) = (&shape.dth[r.clone()], &shape.dph[r.clone()]);
+            let (dps, eps) = (&shape.dps[r.clone()], &shape.eps[r.clone()]);
+            let (wf, wt) = (&self.wf[r.clone()], &self.wt[r.clone()]);
+            let (we, wg) = (&self.we[r.clone()], &self.wg[r.clone()]);
+            for i in 0..len {
+                let (st, ct, sp, cp) = (st[i], ct[i], sp[i], cp[i]);
+                let (dth, dph, dps, eps) = (dth[i], dph[i], dps[i], eps[i]);
+                let (wf, wt, we, wg) = (wf[i], wt[i], we[i], wg[i]);
+                let one = 1.0 + eps;
+                let omega = dph * ct + dps;
+                en[0][i] = 0.5 * wf * (dth * dth + dph * dph * st * st);
+                en[1][i] = 0.5 * wt * omega * omega;
+                en[2][i] = 0.5 * we * eps * eps;
+                let (grav, grav_th, grav_ph, grav_e) = match up {
+                    None => (
+                        wg * one * st * cp,
+                        wg * one * ct * cp,
+                        -wg * one * st * sp,
+                        wg * st * cp,
+                    ),
+                    Some(u) => {
+                        let h = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
+                        let h_th = u[0] * ct * cp + u[1] * ct * sp - u[2] * st;
+                        let h_ph = -u[0] * st * sp + u[1] * st * cp;
+                        (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
+                    }
+                };
+                en[3][i] = grav;
+                let mut g_th = grav_th;
+                if SPATIAL {
+                    g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
+                }
+                f[0][i] = g_th;
+                f[1][i] = wf * dth;
+                f[2][i] = grav_ph;
+                f[3][i] = wf * dph * st * st + wt * omega * ct;
+                f[4][i] = wt * omega;
+                f[5][i] = we * eps + grav_e;
+            }
+            let [fl, to, ex, gr] = &en;
+            for (((&fl, &to), &ex), &gr) in fl[..len].iter().zip(to).zip(ex).zip(gr) {
+                t.flexural += fl;
+                if SPATIAL {
+                    t.torsional += to;
+                }
+                if EXT {
+                    t.extensional += ex;
+                }
+                t.gravitational += gr;
+            }
+            if grad.is_some() {
+                // Four basis functions at a time, their four fields' sums in registers.
+                let (e_lanes, de_lanes) = (&self.e_lanes[r.clone()], &self.de_lanes[r]);
+                for c in 0..C {
+                    let (mut th, mut ph) = (acc[0][c], acc[1][c]);
+                    let (mut ps, mut ep) = (acc[2][c], acc[3][c]);
+                    for (i, (e, de)) in e_lanes.iter().zip(de_lanes).enumerate() {
+                        for l in 0..4 {
+                            let (e, de) = (e[4 * c + l], de[4 * c + l]);
+                            th[l] += f[0][i] * e + f[1][i] * de;
+                            if SPATIAL {
+                                ph[l] += f[2][i] * e + f[3][i] * de;
+                                ps[l] += f[4][i] * de;
+                            }
+                            if EXT {
+                                ep[l] += f[5][i] * e;
+                            }
+                        }
+                    }
+                    (acc[0][c], acc[1][c], acc[2][c], acc[3][c]) = (th, ph, ps, ep);
+                }
+            }
+            start += len;
+        }
+        if let Some(g) = grad {
+            for (o, acc) in offsets.iter().zip(acc.iter()) {
+                if let Some(o) = *o {
+                    for (i, gi) in g[o..o + nb].iter_mut().enumerate() {
+                        *gi = acc[i / 4][i % 4];
+                    }
+                }
+            }
+        }
     }
 
     /// The node sums of a planar, inextensible rod in the case's axes (`φ = ψ = ε = 0`, so
