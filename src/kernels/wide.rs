@@ -56,3 +56,23 @@ macro_rules! dispatch {
     };
 }
 pub(crate) use dispatch;
+
+/// Calls `$this.$f::<C, A, B>(args…)` with the sums' vector count `C` (3 for at most 12 basis
+/// functions per field, else 4) and the two field flags `A`, `B` as constants: the kernels
+/// that keep their sums in registers are compiled for each layout, so that each keeps only
+/// the sums its layout has.
+macro_rules! by_layout {
+    ($wide:expr, $a:expr, $b:expr, $this:ident . $f:ident ( $($arg:expr),* $(,)? )) => {
+        match ($wide, $a, $b) {
+            (false, false, false) => $this.$f::<3, false, false>($($arg),*),
+            (false, false, true) => $this.$f::<3, false, true>($($arg),*),
+            (false, true, false) => $this.$f::<3, true, false>($($arg),*),
+            (false, true, true) => $this.$f::<3, true, true>($($arg),*),
+            (true, false, false) => $this.$f::<4, false, false>($($arg),*),
+            (true, false, true) => $this.$f::<4, false, true>($($arg),*),
+            (true, true, false) => $this.$f::<4, true, false>($($arg),*),
+            (true, true, true) => $this.$f::<4, true, true>($($arg),*),
+        }
+    };
+}
+pub(crate) use by_layout;

@@ -105,7 +105,8 @@ impl Model {
                 // More than `LANES` basis functions: the factors first, then their sums.
                 let mut factors = Vec::with_capacity(if grad.is_some() { nodes } else { 0 });
                 for q in 0..nodes {
-                    let f = self.node_terms(shape, q, spatial, oe.is_some(), up, &mut t);
+                    let (terms, f) = self.node_values(shape, q, spatial, up);
+                    Self::add_terms(&mut t, &terms, spatial, oe.is_some());
                     if grad.is_some() {
                         factors.push(f);
                     }
@@ -117,18 +118,13 @@ impl Model {
                 // A planar, inextensible rod in the case's axes: without the zero terms.
                 self.planar_node_terms(shape, &mut t, grad.as_deref_mut());
             } else {
-                let g = grad.as_deref_mut();
-                let t = &mut t;
-                match (self.nb() > 12, spatial, oe.is_some()) {
-                    (false, false, false) => self.fused_node_sums::<3, false, false>(shape, t, g),
-                    (false, false, true) => self.fused_node_sums::<3, false, true>(shape, t, g),
-                    (false, true, false) => self.fused_node_sums::<3, true, false>(shape, t, g),
-                    (false, true, true) => self.fused_node_sums::<3, true, true>(shape, t, g),
-                    (true, false, false) => self.fused_node_sums::<4, false, false>(shape, t, g),
-                    (true, false, true) => self.fused_node_sums::<4, false, true>(shape, t, g),
-                    (true, true, false) => self.fused_node_sums::<4, true, false>(shape, t, g),
-                    (true, true, true) => self.fused_node_sums::<4, true, true>(shape, t, g),
-                }
+                let (g, t) = (grad.as_deref_mut(), &mut t);
+                crate::kernels::wide::by_layout!(
+                    self.nb() > 12,
+                    spatial,
+                    oe.is_some(),
+                    self.fused_node_sums(shape, t, g)
+                )
             }
         }
         let base = self.base_position(a);
@@ -158,31 +154,23 @@ impl Model {
         t
     }
 
-    /// Node `q`'s terms added to `t`, and its factors of the basis rows in the gradient
-    /// (d/dθ, d/dθ', d/dφ, d/dφ', d/dψ', d/dε), which [`Model::add_node_sums`] or
-    /// [`Model::fused_node_sums`] add up over the nodes.
+    /// Node `q`'s terms (flexure, torsion, extension, gravity; only those the layout has are
+    /// added up) and its factors of the basis rows in the gradient (d/dθ, d/dθ', d/dφ, d/dφ',
+    /// d/dψ', d/dε), which [`Model::add_node_sums`] or [`Model::fused_node_sums`] add up over
+    /// the nodes.
     #[inline(always)]
-    fn node_terms(
+    fn node_values(
         &self,
         shape: &Shape,
         q: usize,
         spatial: bool,
-        ext: bool,
         up: Option<[f64; 3]>,
-        t: &mut EnergyTerms,
-    ) -> [f64; 6] {
+    ) -> ([f64; 4], [f64; 6]) {
         let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
         let (dth, dph, dps, eps) = (shape.dth[q], shape.dph[q], shape.dps[q], shape.eps[q]);
         let one = 1.0 + eps;
         let (wf, wt, we, wg) = (self.wf[q], self.wt[q], self.we[q], self.wg[q]);
         let omega = dph * ct + dps;
-        t.flexural += 0.5 * wf * (dth * dth + dph * dph * st * st);
-        if spatial {
-            t.torsional += 0.5 * wt * omega * omega;
-        }
-        if ext {
-            t.extensional += 0.5 * we * eps * eps;
-        }
         // Gravity `wg (1+ε) h` for the tangent's height `h = ζ·x̂` (`sθcφ` in the case's
         // axes, `u·ζ` for the vertical `u` of an angles' frame): its value and its θ, φ
         // and ε derivatives.
@@ -200,14 +188,40 @@ impl Model {
                 (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
             }
         };
-        t.gravitational += grav;
+        let terms = [
+            0.5 * wf * (dth * dth + dph * dph * st * st),
+            0.5 * wt * omega * omega,
+            0.5 * we * eps * eps,
+            grav,
+        ];
         let mut g_th = grav_th;
-        let g_dth = wf * dth;
         if spatial {
             g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
         }
         let g_dph = wf * dph * st * st + wt * omega * ct;
-        [g_th, g_dth, grav_ph, g_dph, wt * omega, we * eps + grav_e]
+        let factors = [
+            g_th,
+            wf * dth,
+            grav_ph,
+            g_dph,
+            wt * omega,
+            we * eps + grav_e,
+        ];
+        (terms, factors)
+    }
+
+    /// Adds a node's `terms` ([`Model::node_values`]) to `t`: torsion only on a 3D rod,
+    /// extension only on an extensible one.
+    #[inline(always)]
+    fn add_terms(t: &mut EnergyTerms, terms: &[f64; 4], spatial: bool, ext: bool) {
+        t.flexural += terms[0];
+        if spatial {
+            t.torsional += terms[1];
+        }
+        if ext {
+            t.extensional += terms[2];
+        }
+        t.gravitational += terms[3];
     }
 
     /// The node terms and, with `grad`, their sums for `nb ≤ 4 C` basis functions, with
@@ -252,57 +266,18 @@ impl Model {
             // Each node's energies (flexure, torsion, extension, gravity) and factors.
             let mut en = [[0.0; BLOCK]; 4];
             let mut f = [[0.0; BLOCK]; 6];
-            let (st, ct) = (&shape.sth[r.clone()], &shape.cth[r.clone()]);
-            let (sp, cp) = (&shape.sph[r.clone()], &shape.cph[r.clone()]);
-            let (dth, dph) = (&shape.dth[r.clone()], &shape.dph[r.clone()]);
-            let (dps, eps) = (&shape.dps[r.clone()], &shape.eps[r.clone()]);
-            let (wf, wt) = (&self.wf[r.clone()], &self.wt[r.clone()]);
-            let (we, wg) = (&self.we[r.clone()], &self.wg[r.clone()]);
-            for i in 0..len {
-                let (st, ct, sp, cp) = (st[i], ct[i], sp[i], cp[i]);
-                let (dth, dph, dps, eps) = (dth[i], dph[i], dps[i], eps[i]);
-                let (wf, wt, we, wg) = (wf[i], wt[i], we[i], wg[i]);
-                let one = 1.0 + eps;
-                let omega = dph * ct + dps;
-                en[0][i] = 0.5 * wf * (dth * dth + dph * dph * st * st);
-                en[1][i] = 0.5 * wt * omega * omega;
-                en[2][i] = 0.5 * we * eps * eps;
-                let (grav, grav_th, grav_ph, grav_e) = match up {
-                    None => (
-                        wg * one * st * cp,
-                        wg * one * ct * cp,
-                        -wg * one * st * sp,
-                        wg * st * cp,
-                    ),
-                    Some(u) => {
-                        let h = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
-                        let h_th = u[0] * ct * cp + u[1] * ct * sp - u[2] * st;
-                        let h_ph = -u[0] * st * sp + u[1] * st * cp;
-                        (wg * one * h, wg * one * h_th, wg * one * h_ph, wg * h)
-                    }
-                };
-                en[3][i] = grav;
-                let mut g_th = grav_th;
-                if SPATIAL {
-                    g_th += wf * dph * dph * st * ct - wt * omega * dph * st;
+            for (i, q) in r.clone().enumerate() {
+                let (terms, factors) = self.node_values(shape, q, SPATIAL, up);
+                for (en, v) in en.iter_mut().zip(terms) {
+                    en[i] = v;
                 }
-                f[0][i] = g_th;
-                f[1][i] = wf * dth;
-                f[2][i] = grav_ph;
-                f[3][i] = wf * dph * st * st + wt * omega * ct;
-                f[4][i] = wt * omega;
-                f[5][i] = we * eps + grav_e;
+                for (f, v) in f.iter_mut().zip(factors) {
+                    f[i] = v;
+                }
             }
             let [fl, to, ex, gr] = &en;
             for (((&fl, &to), &ex), &gr) in fl[..len].iter().zip(to).zip(ex).zip(gr) {
-                t.flexural += fl;
-                if SPATIAL {
-                    t.torsional += to;
-                }
-                if EXT {
-                    t.extensional += ex;
-                }
-                t.gravitational += gr;
+                Self::add_terms(t, &[fl, to, ex, gr], SPATIAL, EXT);
             }
             if grad.is_some() {
                 // Four basis functions at a time, their four fields' sums in registers.

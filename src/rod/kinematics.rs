@@ -207,16 +207,12 @@ impl Model {
     fn positions_vjp_lanes(&self, shape: &Shape, v: &[[f64; 3]], grad: &mut [f64]) {
         let angles = self.layout.offset(Field::Phi).is_some();
         let ext = self.layout.offset(Field::Eps).is_some();
-        match (self.nb() > 12, angles, ext) {
-            (false, false, false) => self.vjp_lanes::<3, false, false>(shape, v, grad),
-            (false, false, true) => self.vjp_lanes::<3, false, true>(shape, v, grad),
-            (false, true, false) => self.vjp_lanes::<3, true, false>(shape, v, grad),
-            (false, true, true) => self.vjp_lanes::<3, true, true>(shape, v, grad),
-            (true, false, false) => self.vjp_lanes::<4, false, false>(shape, v, grad),
-            (true, false, true) => self.vjp_lanes::<4, false, true>(shape, v, grad),
-            (true, true, false) => self.vjp_lanes::<4, true, false>(shape, v, grad),
-            (true, true, true) => self.vjp_lanes::<4, true, true>(shape, v, grad),
-        }
+        crate::kernels::wide::by_layout!(
+            self.nb() > 12,
+            angles,
+            ext,
+            self.vjp_lanes(shape, v, grad)
+        )
     }
 
     /// [`Model::positions_vjp_lanes`] for `nb ≤ 4 C`, with (`ANGLES`) or without the φ field
