@@ -252,9 +252,17 @@ fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f6
         }
         return;
     }
-    for (o, &b) in out.iter_mut().zip(&c.samples) {
-        let x = positions[b].map(|v| v * c.length);
-        let d = c.obstacle.signed_distance_value(x);
-        *o = c.clearance - d / c.length;
+    // The sample points gathered a batch at a time, their distances side by side.
+    let mut pts = [[0.0; 3]; 64];
+    let mut d = [0.0; 64];
+    for (o, samples) in out.chunks_mut(64).zip(c.samples.chunks(64)) {
+        for (p, &b) in pts.iter_mut().zip(samples) {
+            *p = positions[b].map(|v| v * c.length);
+        }
+        let n = samples.len();
+        c.obstacle.signed_distance_values(&pts[..n], &mut d[..n]);
+        for (o, d) in o.iter_mut().zip(&d[..n]) {
+            *o = c.clearance - d / c.length;
+        }
     }
 }

@@ -96,9 +96,10 @@ fn gaps_at(fine: &Model, obstacles: &[Arc<Obstacle>], positions: &[[f64; 3]]) ->
     let gaps = obstacles
         .iter()
         .map(|o| {
-            pts.iter()
-                .map(|&p| o.signed_distance_value(p) - r)
-                .collect()
+            let mut d = vec![0.0; pts.len()];
+            o.signed_distance_values(&pts, &mut d);
+            d.iter_mut().for_each(|d| *d -= r);
+            d
         })
         .collect();
     (pts, gaps)

@@ -12,6 +12,8 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriMesh};
 use std::sync::Arc;
 
+mod lanes;
+
 /// Geometry of an obstacle in its local frame.
 #[derive(Clone)]
 pub enum ObstacleShape {
