@@ -8,7 +8,7 @@
 
 use super::{Obstacle, ObstacleShape, v3};
 
-/// Points per call.
+/// Points per vector.
 pub const LANES: usize = 4;
 
 /// Points per batch: their local coordinates are gathered on the stack, then the kernels run
@@ -27,7 +27,13 @@ impl Obstacle {
     fn batch(&self, points: &[[f64; 3]], out: &mut [f64]) {
         let n = points.len().min(out.len());
         #[cfg(target_arch = "x86_64")]
-        if n >= LANES && crate::kernels::wide::avx2() {
+        if n >= LANES
+            && matches!(
+                self.shape,
+                ObstacleShape::Ball(_) | ObstacleShape::Capsule(_) | ObstacleShape::Cuboid(_)
+            )
+            && crate::kernels::wide::avx2()
+        {
             let whole = n - n % LANES;
             let mut xyz = [[0.0; BATCH]; 3];
             for (i, p) in points[..whole].iter().enumerate() {
