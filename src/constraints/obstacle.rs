@@ -253,9 +253,10 @@ fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f6
         return;
     }
     // The sample points gathered a batch at a time, their distances side by side.
-    let mut pts = [[0.0; 3]; 64];
-    let mut d = [0.0; 64];
-    for (o, samples) in out.chunks_mut(64).zip(c.samples.chunks(64)) {
+    use crate::scene::obstacle::BATCH;
+    let mut pts = [[0.0; 3]; BATCH];
+    let mut d = [0.0; BATCH];
+    for (o, samples) in out.chunks_mut(BATCH).zip(c.samples.chunks(BATCH)) {
         for (p, &b) in pts.iter_mut().zip(samples) {
             *p = positions[b].map(|v| v * c.length);
         }

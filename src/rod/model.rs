@@ -112,8 +112,8 @@ pub struct Model {
     /// Basis values, node-major, each node's padded with zeros to [`LANES`] (empty when
     /// `nb > LANES`): the positions' vector–Jacobian product keeps its sums in registers.
     pub(crate) e_lanes: Vec<[f64; LANES]>,
-    /// Basis derivatives in [`Model::e_lanes`]'s form: a planar rod's energy gradient keeps its
-    /// sums in registers.
+    /// Basis derivatives in [`Model::e_lanes`]'s form: the energy gradient keeps its sums in
+    /// registers.
     pub(crate) de_lanes: Vec<[f64; LANES]>,
     /// `w · Rf(t)/Rf`.
     pub(crate) wf: Vec<f64>,

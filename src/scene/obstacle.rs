@@ -13,6 +13,7 @@ use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, TriM
 use std::sync::Arc;
 
 mod lanes;
+pub(crate) use lanes::BATCH;
 
 /// Geometry of an obstacle in its local frame.
 #[derive(Clone)]

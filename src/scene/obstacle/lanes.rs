@@ -12,8 +12,9 @@ use super::{Obstacle, ObstacleShape, v3};
 pub const LANES: usize = 4;
 
 /// Points per batch: their local coordinates are gathered on the stack, then the kernels run
-/// over them four at a time (consecutive fours overlap in the processor).
-const BATCH: usize = 64;
+/// over them four at a time (consecutive fours overlap in the processor). Callers that gather
+/// the points themselves do it a batch at a time too.
+pub(crate) const BATCH: usize = 64;
 
 impl Obstacle {
     /// `out[i]` = [`Obstacle::signed_distance_value`] of `points[i]` (case units).
