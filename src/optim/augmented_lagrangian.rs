@@ -121,6 +121,10 @@ pub struct AlOutcome {
     pub evaluations: usize,
     /// Final penalty.
     pub rho: f64,
+    /// Whether [`AlOptions::hold_penalty_when_feasible`] kept the penalty at some outer
+    /// iteration that would otherwise have raised it (false: the run is the same bit for bit
+    /// as without that option).
+    pub penalty_held: bool,
 }
 
 /// Constraint violation of values `c`.
@@ -292,6 +296,7 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
     let mut last = LastValues::default();
     let mut viol_prev = f64::INFINITY;
     let mut status = AlStatus::IterationLimit;
+    let mut penalty_held = false;
     let mut outer = 0;
     let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
@@ -447,9 +452,10 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
             status = AlStatus::Converged;
             break;
         }
-        if viol > 0.25 * viol_prev
-            && (viol > opts.feasibility_tol || !opts.hold_penalty_when_feasible)
-        {
+        let slow = viol > 0.25 * viol_prev;
+        let hold = opts.hold_penalty_when_feasible && viol <= opts.feasibility_tol;
+        penalty_held |= slow && hold;
+        if slow && !hold {
             dual_ok = false;
             if rho >= opts.rho_max && viol > opts.feasibility_tol && outer > 5 {
                 status = AlStatus::Infeasible;
@@ -498,6 +504,7 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
         inner_iterations,
         evaluations,
         rho,
+        penalty_held,
     }
 }
 
@@ -949,10 +956,33 @@ mod tests {
             };
             let out = augmented_lagrangian(&mut q, &mut x, Some(&[ls]), opts);
             assert_spread_solved(&q, &x, &out);
-            (out.rho, out.outer_iterations)
+            (out.rho, out.outer_iterations, out.penalty_held)
         };
         let (held, raised) = (run(true), run(false));
         assert_eq!(held.0, 1e2);
         assert!(raised.0 >= 1e3, "{raised:?}");
+        // The outcome says whether the hold took effect.
+        assert!(held.2 && !raised.2);
+        // A run from far away, which the hold never changes, says so and matches the run
+        // without it to the bit.
+        let cold = |hold: bool| {
+            let mut q = Spread::uniform(1.0);
+            let mut x = vec![0.0; 6];
+            let opts = AlOptions {
+                second_order: false,
+                rho_initial: 1e2,
+                feasibility_tol: 1e-6,
+                optimality_tol: 1e-5,
+                hold_penalty_when_feasible: hold,
+                ..AlOptions::default()
+            };
+            let out = augmented_lagrangian(&mut q, &mut x, None, opts);
+            (x, out)
+        };
+        let ((xh, oh), (xr, or)) = (cold(true), cold(false));
+        assert!(!oh.penalty_held && !or.penalty_held);
+        assert_eq!(xh, xr);
+        assert_eq!((oh.rho, oh.evaluations), (or.rho, or.evaluations));
+        assert_eq!(oh.lambda, or.lambda);
     }
 }

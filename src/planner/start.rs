@@ -10,6 +10,7 @@ use super::verify::Verification;
 use super::workers::Workers;
 use super::{Planner, settings};
 use crate::optim::{AlOptions, AlStatus, augmented_lagrangian_warm};
+use std::sync::Arc;
 
 /// Optimality tolerance of a 3D rod's sharpness stages before the last (feasibility: a tenth
 /// of it); the last stage keeps [`Planner::stage_options`]'. On the generated suite (seeds 1
@@ -47,11 +48,27 @@ pub(super) struct Curvature {
 }
 
 /// Where a start's sharpness stages begin: at stage `stage`, and, where the stages carry the
-/// curvature ([`Planner::stages_carry_curvature`]), from `curvature`.
+/// curvature ([`Planner::stages_carry_curvature`]), from `curvature`; or, given `first`, after
+/// that first stage, already run.
 #[derive(Clone, Default)]
 pub(super) struct Resume {
     pub(super) stage: usize,
     pub(super) curvature: Curvature,
+    pub(super) first: Option<Arc<FirstStage>>,
+}
+
+/// A quick start's first sharpness stage, where it ran as a start of the case's own attempt
+/// from the same path would: from a scaled identity and the first penalty, and without the
+/// quick attempt's penalty hold ever taking effect ([`crate::optim::AlOutcome::penalty_held`]).
+/// The case's own start from the same path then begins after it, bit for bit where it would
+/// have been, and reports its progress again.
+pub(super) struct FirstStage {
+    /// The path after the stage.
+    z: Vec<f64>,
+    /// The multiplier method's results after the stage.
+    tally: Tally,
+    /// The progress the stage reported, with each report's worst shape.
+    progress: Vec<(Progress, Vec<f64>)>,
 }
 
 #[derive(Clone)]
@@ -72,6 +89,9 @@ pub(super) struct StartRun {
     /// A quick start's BFGS inverse-Hessian approximation and penalty as its last stage ended,
     /// for a refinement's rerun to start from (empty for other starts).
     pub(super) curvature: Curvature,
+    /// A quick start's first stage, where the case's own start from the same path may begin
+    /// after it ([`FirstStage`]).
+    pub(super) first_stage: Option<Arc<FirstStage>>,
 }
 
 impl StartRun {
@@ -91,6 +111,7 @@ impl StartRun {
             equilibrium_deviation: None,
             settled: true,
             curvature: Curvature::default(),
+            first_stage: None,
         }
     }
 }
@@ -172,6 +193,18 @@ impl Planner {
         };
         let al = self.stage_options();
         let mut z = z0;
+        // A case's own start after the quick start's first stage: its path, multipliers,
+        // evaluations and progress are this start's own first stage's.
+        if let Some(first) = &from.first {
+            z.clone_from(&first.z);
+            tally = first.tally.clone();
+            for (p, w) in &first.progress {
+                sink(Progress { start, ..*p }, w.clone());
+            }
+        }
+        // A quick start records its first stage's progress.
+        let mut first_progress = (self.quick && from.stage == 0).then(Vec::new);
+        let mut first_stage = None;
         let carry = self.stages_carry_curvature();
         // BFGS's inverse-Hessian approximation (empty: a scaled identity), and the penalty.
         let (mut hinv, mut rho) = if carry && !from.curvature.hinv.is_empty() {
@@ -208,6 +241,13 @@ impl Planner {
             }
             let out = {
                 let sink = &mut *sink;
+                let mut record = first_progress.as_mut().filter(|_| stage == 0);
+                let mut sink = |p: Progress, w: Vec<f64>| {
+                    if let Some(r) = record.as_mut() {
+                        r.push((p, w.clone()));
+                    }
+                    sink(p, w)
+                };
                 let ks = p.ks.clone();
                 let mw = p.mean_weight;
                 // `q` is the problem evaluated at the iterate: its sampled energies and shapes
@@ -247,8 +287,19 @@ impl Planner {
             if carry {
                 rho = out.rho.max(al.rho_initial);
             }
+            let held = out.penalty_held;
             if tally.absorb(out) || self.stopped() {
                 break;
+            }
+            if stage == 0
+                && !held
+                && let Some(progress) = first_progress.take()
+            {
+                first_stage = Some(Arc::new(FirstStage {
+                    z: z.clone(),
+                    tally: tally.clone(),
+                    progress,
+                }));
             }
             // The quick attempt's continuation ends at the first converged stage whose samples
             // peak at an end shape: it has attained the lower bound on the samples, and the
@@ -301,6 +352,7 @@ impl Planner {
             } else {
                 Curvature::default()
             },
+            first_stage,
         }
     }
 }
@@ -346,6 +398,8 @@ impl Planner {
         let better = |a: &Verification, b: &Verification| {
             (a.collision_free(tol), -a.u_max) > (b.collision_free(tol), -b.u_max)
         };
+        let mut run = run;
+        let first_stage = run.first_stage.take();
         let mut chosen = run;
         let mut ver = check(&chosen.z);
         let mut ks = uniform.to_vec();
@@ -399,6 +453,7 @@ impl Planner {
             let from = Resume {
                 stage: last,
                 curvature: chosen.curvature.clone(),
+                first: None,
             };
             let r = self.optimise_from(start, chosen.z.clone(), &ks, from, workers, sink);
             chosen = StartRun {
@@ -416,6 +471,7 @@ impl Planner {
             };
             ver = kv;
         }
+        chosen.first_stage = first_stage;
         Verified {
             run: chosen,
             verification: ver,

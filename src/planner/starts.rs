@@ -193,7 +193,7 @@ impl Planner {
             let check = |z: &[f64]| self.verify_on(fine, &path, z, false);
             // Start s: the straight-line path plus a perturbation of seed `seed + s`, 0.01 rad
             // for the first, `start_spread` for the others.
-            let zs: Vec<(usize, Vec<f64>)> = (0..starts)
+            let zs: Vec<(usize, Vec<f64>, Resume)> = (0..starts)
                 .map(|s| {
                     let amp = if s == 0 {
                         1e-2
@@ -204,7 +204,26 @@ impl Planner {
                         .into_iter()
                         .map(|v| amp * v)
                         .collect();
-                    (attempt * starts + s, z0)
+                    // The case's own start begins after the first stage of the quick start
+                    // from the same path where that stage ran as its own would have.
+                    let first = (kind == Attempt::Own)
+                        .then(|| {
+                            runs.iter().find(|r| {
+                                r.attempt == Attempt::Quick
+                                    && r.index == s
+                                    && r.terms == pl.settings.path_terms
+                                    && r.travel_weight == pl.settings.travel_weight
+                                    && r.swept_clearance == pl.settings.swept()
+                            })
+                        })
+                        .flatten()
+                        .and_then(|r| r.plan.run.first_stage.clone());
+                    let from = Resume {
+                        stage: usize::from(first.is_some()),
+                        first,
+                        ..Resume::default()
+                    };
+                    (attempt * starts + s, z0, from)
                 })
                 .collect();
             // The quick attempt runs its first group only.
@@ -219,14 +238,19 @@ impl Planner {
                 // their collisions say nothing about the case's own attempt.)
                 tunnelled |=
                     kind != Attempt::Quick && done.iter().all(|v| !self.class(v).collision_free);
-                runs.extend(group.iter().zip(done).map(|((index, _), plan)| StartPlan {
-                    index: *index,
-                    attempt: kind,
-                    terms: pl.settings.path_terms,
-                    travel_weight: pl.settings.travel_weight,
-                    swept_clearance: pl.settings.swept(),
-                    plan,
-                }));
+                runs.extend(
+                    group
+                        .iter()
+                        .zip(done)
+                        .map(|((index, _, _), plan)| StartPlan {
+                            index: *index,
+                            attempt: kind,
+                            terms: pl.settings.path_terms,
+                            travel_weight: pl.settings.travel_weight,
+                            swept_clearance: pl.settings.swept(),
+                            plan,
+                        }),
+                );
                 // Checked before the next group, and before the next fallback planner is made.
                 if self.stopped() {
                     break 'attempts;
@@ -241,13 +265,13 @@ impl Planner {
 }
 
 impl Planner {
-    /// Optimises from each of `starts` (start index and perturbation of the straight-line path)
-    /// on the samples `uniform`, then verifies and refines each plan with `check`
+    /// Optimises from each of `starts` (start index, perturbation of the straight-line path and
+    /// where its stages begin) on the samples `uniform`, then verifies and refines each plan with `check`
     /// ([`Planner::refine`]), on parallel threads when there are several starts, telling
     /// `observer` their progress as it happens.
     pub(super) fn optimise_starts(
         &self,
-        starts: &[(usize, Vec<f64>)],
+        starts: &[(usize, Vec<f64>, Resume)],
         uniform: &[f64],
         check: &(dyn Fn(&[f64]) -> Verification + Sync),
         observer: &mut dyn PlanObserver,
@@ -258,9 +282,8 @@ impl Planner {
                 observer.progress(model, &p, &w);
                 self.poll(observer);
             };
-            let (i, z0) = starts[0].clone();
-            let run =
-                self.optimise_from(i, z0, uniform, Resume::default(), &self.workers, &mut sink);
+            let (i, z0, from) = starts[0].clone();
+            let run = self.optimise_from(i, z0, uniform, from, &self.workers, &mut sink);
             vec![self.refine(i, run, uniform, check, &self.workers, &mut sink)]
         } else {
             let workers = std::thread::available_parallelism()
@@ -287,17 +310,11 @@ impl Planner {
                             };
                             idx.into_iter()
                                 .map(|j| {
-                                    let (i, z0) = starts[j].clone();
+                                    let (i, z0, from) = starts[j].clone();
                                     // The starts already share the cores.
                                     let one = super::workers::Workers::serial();
-                                    let run = self.optimise_from(
-                                        i,
-                                        z0,
-                                        uniform,
-                                        Resume::default(),
-                                        &one,
-                                        &mut sink,
-                                    );
+                                    let run =
+                                        self.optimise_from(i, z0, uniform, from, &one, &mut sink);
                                     (j, self.refine(i, run, uniform, check, &one, &mut sink))
                                 })
                                 .collect::<Vec<_>>()
