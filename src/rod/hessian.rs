@@ -81,6 +81,41 @@ impl Model {
         }
     }
 
+    /// Adds `Σ w e(t_q) e(t_q)ᵀ` over `terms = [(q, w)]` (in their order) to the θθ block of `h`
+    /// (row-major `n×n`): every entry the same sums, in the same order, as [`Model::assemble_local`]
+    /// with only a θθ entry.
+    #[inline(always)]
+    fn add_theta_outer(&self, terms: &[(usize, f64)], h: &mut [f64]) {
+        let (n, nb) = (self.n(), self.nb());
+        if self.e_lanes.is_empty() {
+            for &(q, w) in terms {
+                let e = self.e_at(q);
+                for i in 0..nb {
+                    let wi = w * e[i];
+                    for (r, v) in h[i * n..i * n + nb].iter_mut().zip(e) {
+                        *r += wi * v;
+                    }
+                }
+            }
+        } else {
+            // Row by row, each row's sums in a fixed-size array (registers) across the
+            // nodes: every entry still adds the same terms in node order.
+            for i in 0..nb {
+                let row = &mut h[i * n..i * n + nb];
+                let mut acc = [0.0; LANES];
+                acc[..nb].copy_from_slice(row);
+                for &(q, w) in terms {
+                    let e = &self.e_lanes[q];
+                    let wi = w * e[i];
+                    for (a, &v) in acc.iter_mut().zip(e) {
+                        *a += wi * v;
+                    }
+                }
+                row.copy_from_slice(&acc[..nb]);
+            }
+        }
+    }
+
     /// The constant part of the energy Hessian: `Σ_q wf θ'θ' + wt ψ'ψ' + we εε` terms.
     pub(crate) fn assemble_constant_hessian(&self) -> Vec<f64> {
         let n = self.n();
@@ -119,7 +154,31 @@ impl Model {
         // A weightless planar rod (the energy is the quadratic form): every local entry below
         // is zero, and the assembly would skip them all.
         let quadratic = !self.energy_roots.is_empty();
-        if !quadratic {
+        let lay = &self.layout;
+        let theta_only = [Field::Phi, Field::Psi, Field::Eps]
+            .iter()
+            .all(|&f| lay.offset(f).is_none());
+        if !quadratic && theta_only {
+            // A weighted rod whose only field is θ: gravity's θθ entry is the only local one
+            // (the same value, and the same sums in node order, as the assembly below).
+            let up = self.up();
+            let terms: Vec<(usize, f64)> = (0..self.nodes())
+                .map(|q| {
+                    let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+                    let one = 1.0 + shape.eps[q];
+                    let wg = self.wg[q];
+                    let hth = if let Some(u) = up {
+                        let f = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
+                        -wg * one * f
+                    } else {
+                        -wg * one * st * cp
+                    };
+                    (q, hth * scale)
+                })
+                .filter(|&(_, w)| w != 0.0)
+                .collect();
+            self.add_theta_outer(&terms, h);
+        } else if !quadratic {
             let up = self.up();
             self.assemble_local(h, |q, hq| {
                 let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
@@ -197,7 +256,6 @@ impl Model {
         if self.layout.offset(Field::Phi).is_none() && self.layout.offset(Field::Eps).is_none() {
             // Planar and inextensible: only the θθ entry, `−w (S₀ sθ + S₂ cθ) e eᵀ`, the same
             // sums the general assembly does for it, without the absent quantities.
-            let (n, nb) = (self.n(), self.nb());
             // The nodes that contribute, in node order, with their weights.
             let mut terms = Vec::with_capacity(self.nodes());
             for (j, s) in suffix.iter().enumerate() {
@@ -213,33 +271,7 @@ impl Model {
                     }
                 }
             }
-            if self.e_lanes.is_empty() {
-                for &(q, w) in &terms {
-                    let e = self.e_at(q);
-                    for i in 0..nb {
-                        let wi = w * e[i];
-                        for (r, v) in h[i * n..i * n + nb].iter_mut().zip(e) {
-                            *r += wi * v;
-                        }
-                    }
-                }
-            } else {
-                // Row by row, each row's sums in a fixed-size array (registers) across the
-                // nodes: every entry still adds the same terms in node order.
-                for i in 0..nb {
-                    let row = &mut h[i * n..i * n + nb];
-                    let mut acc = [0.0; LANES];
-                    acc[..nb].copy_from_slice(row);
-                    for &(q, w) in &terms {
-                        let e = &self.e_lanes[q];
-                        let wi = w * e[i];
-                        for (a, &v) in acc.iter_mut().zip(e) {
-                            *a += wi * v;
-                        }
-                    }
-                    row.copy_from_slice(&acc[..nb]);
-                }
-            }
+            self.add_theta_outer(&terms, h);
             return;
         }
         let mut panel_of = vec![0; self.nodes()];
@@ -582,6 +614,31 @@ mod tests {
                 );
                 assert_close(&h, &fd);
             }
+        }
+    }
+
+    #[test]
+    fn weighted_theta_rod_hessian_is_the_assembly_to_the_bit() {
+        // A weighted planar inextensible rod takes its own θθ loop; the general assembly of
+        // the same local entry must give the same bits.
+        let m = model(false, false);
+        assert!(m.energy_roots.is_empty(), "the test rod has weight");
+        let n = m.n();
+        let sh = m.evaluate(&coefficients(n));
+        let scale = 0.7;
+        let mut h = vec![0.0; n * n];
+        m.add_energy_hessian(&sh, Objective::Potential, scale, &mut h);
+        let mut expect = vec![0.0; n * n];
+        for (e, k) in expect.iter_mut().zip(&m.constant_hessian) {
+            *e += scale * k;
+        }
+        m.assemble_local(&mut expect, |q, hq| {
+            hq[super::TH][super::TH] = -m.wg[q] * (1.0 + sh.eps[q]) * sh.sth[q] * sh.cph[q];
+            hq[super::TH][super::TH] *= scale;
+        });
+        assert!(h.iter().any(|v| *v != 0.0));
+        for (i, (x, y)) in h.iter().zip(&expect).enumerate() {
+            assert_eq!(x.to_bits(), y.to_bits(), "entry {i}: {x} vs {y}");
         }
     }
 
