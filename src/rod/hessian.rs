@@ -382,6 +382,9 @@ impl Model {
         let n = self.n();
         let nb = self.nb();
         let ps = &self.mesh.panel_start;
+        if !self.e_lanes.is_empty() && n == nb {
+            return self.planar_gauss_newton_rows(shape, c, h);
+        }
         let mut jx = vec![0.0; n];
         let mut jz = vec![0.0; n];
         // The base's Jacobian is zero: `c[0]` adds nothing.
@@ -400,6 +403,50 @@ impl Model {
                 add_rank_one(h, cj, &jx);
                 add_rank_one(h, cj, &jz);
             }
+        }
+    }
+
+    /// [`Model::planar_gauss_newton_body`] with the boundaries' Jacobian rows gathered first,
+    /// then added row by row of `h` with each row's sums in a fixed-size array (registers):
+    /// every entry adds the same terms in the same order, skipping the same zero weights.
+    #[inline(always)]
+    fn planar_gauss_newton_rows(&self, shape: &Shape, c: &[f64], h: &mut [f64]) {
+        let n = self.n();
+        let ps = &self.mesh.panel_start;
+        // Per boundary with a weight: the weight, then the x and z rows (zero past `nb`).
+        let mut rows: Vec<(f64, [f64; LANES], [f64; LANES])> =
+            Vec::with_capacity(self.mesh.panels());
+        let (mut jx, mut jz) = ([0.0; LANES], [0.0; LANES]);
+        for j in 0..self.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = self.mesh.weights[q];
+                let (wx, wz) = (w * shape.cth[q], w * -shape.sth[q]);
+                let e = &self.e_lanes[q];
+                for ((x, z), ei) in jx.iter_mut().zip(&mut jz).zip(e) {
+                    *x += wx * ei;
+                    *z += wz * ei;
+                }
+            }
+            let cj = c[j + 1];
+            if cj != 0.0 {
+                rows.push((cj, jx, jz));
+            }
+        }
+        for a in 0..n {
+            let row = &mut h[a * n..(a + 1) * n];
+            let mut acc = [0.0; LANES];
+            acc[..n].copy_from_slice(row);
+            for (cj, jx, jz) in &rows {
+                for g in [jx, jz] {
+                    let wa = cj * g[a];
+                    if wa != 0.0 {
+                        for (v, gb) in acc.iter_mut().zip(g) {
+                            *v += wa * gb;
+                        }
+                    }
+                }
+            }
+            row.copy_from_slice(&acc[..n]);
         }
     }
 }
@@ -637,6 +684,49 @@ mod tests {
             hq[super::TH][super::TH] *= scale;
         });
         assert!(h.iter().any(|v| *v != 0.0));
+        for (i, (x, y)) in h.iter().zip(&expect).enumerate() {
+            assert_eq!(x.to_bits(), y.to_bits(), "entry {i}: {x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn planar_gauss_newton_rows_are_the_rank_ones_to_the_bit() {
+        // The planar inextensible Gauss–Newton Hessian adds its boundaries' rows in registers;
+        // one rank-one update per boundary row and weight (zero weights skipped) gives the
+        // same bits.
+        let m = model(false, false);
+        let n = m.n();
+        assert_eq!(n, m.nb());
+        let sh = m.evaluate(&coefficients(n));
+        let nbd = m.mesh.boundaries.len();
+        let c: Vec<f64> = (0..nbd)
+            .map(|b| {
+                if b % 3 == 2 {
+                    0.0
+                } else {
+                    0.5 + 0.1 * b as f64
+                }
+            })
+            .collect();
+        let start: Vec<f64> = (0..n * n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut h = start.clone();
+        m.add_positions_gauss_newton(&sh, &c, &mut h);
+        let mut expect = start;
+        let (mut jx, mut jz) = (vec![0.0; n], vec![0.0; n]);
+        let ps = &m.mesh.panel_start;
+        for j in 0..m.mesh.panels() {
+            for q in ps[j]..ps[j + 1] {
+                let w = m.mesh.weights[q];
+                for (i, ei) in m.e_at(q).iter().enumerate() {
+                    jx[i] += w * sh.cth[q] * ei;
+                    jz[i] += w * -sh.sth[q] * ei;
+                }
+            }
+            if c[j + 1] != 0.0 {
+                super::add_rank_one(&mut expect, c[j + 1], &jx);
+                super::add_rank_one(&mut expect, c[j + 1], &jz);
+            }
+        }
         for (i, (x, y)) in h.iter().zip(&expect).enumerate() {
             assert_eq!(x.to_bits(), y.to_bits(), "entry {i}: {x} vs {y}");
         }
