@@ -253,17 +253,20 @@ fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f6
         return;
     }
     // The sample points gathered a batch at a time, their distances side by side.
+    use crate::kernels::written;
     use crate::scene::obstacle::BATCH;
-    let mut pts = [[0.0; 3]; BATCH];
-    let mut d = [0.0; BATCH];
+    // Left uninitialised beyond the batch's points.
+    let mut pts = [std::mem::MaybeUninit::<[f64; 3]>::uninit(); BATCH];
     for (o, samples) in out.chunks_mut(BATCH).zip(c.samples.chunks(BATCH)) {
         for (p, &b) in pts.iter_mut().zip(samples) {
-            *p = positions[b].map(|v| v * c.length);
+            p.write(positions[b].map(|v| v * c.length));
         }
-        let n = samples.len();
-        c.obstacle.signed_distance_values(&pts[..n], &mut d[..n]);
-        for (o, d) in o.iter_mut().zip(&d[..n]) {
-            *o = c.clearance - d / c.length;
+        // SAFETY: the first `samples.len()` are written just above.
+        let pts = unsafe { written(&pts[..samples.len()]) };
+        // The distances in place, then the rows.
+        c.obstacle.signed_distance_values(pts, o);
+        for o in o.iter_mut() {
+            *o = c.clearance - *o / c.length;
         }
     }
 }

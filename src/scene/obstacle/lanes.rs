@@ -7,6 +7,8 @@
 //! capsule's axis), every other shape and every other processor take the one-point path.
 
 use super::{Obstacle, ObstacleShape, v3};
+use crate::kernels::written;
+use std::mem::MaybeUninit;
 
 /// Points per vector.
 pub const LANES: usize = 4;
@@ -36,12 +38,17 @@ impl Obstacle {
             && crate::kernels::wide::avx2()
         {
             let whole = n - n % LANES;
-            let mut xyz = [[0.0; BATCH]; 3];
+            // Left uninitialised beyond `whole` (zeroing the whole batch cost more than the
+            // gathering on short batches).
+            let mut xyz = [[MaybeUninit::<f64>::uninit(); BATCH]; 3];
             for (i, p) in points[..whole].iter().enumerate() {
                 let v = self.to_local(v3(*p));
-                (xyz[0][i], xyz[1][i], xyz[2][i]) = (v.x, v.y, v.z);
+                xyz[0][i].write(v.x);
+                xyz[1][i].write(v.y);
+                xyz[2][i].write(v.z);
             }
-            let c = [&xyz[0][..whole], &xyz[1][..whole], &xyz[2][..whole]];
+            // SAFETY: the first `whole` of each are written just above.
+            let c = xyz.each_ref().map(|x| unsafe { written(&x[..whole]) });
             let mut redo = [false; BATCH];
             let done = match &self.shape {
                 // SAFETY (all three): the processor has AVX2 (checked above).
