@@ -1,6 +1,8 @@
-//! Which sampled shapes the planning objective may leave out: samples that certainly keep clear
-//! of every obstacle, by a bound on how far their positions can have moved since their shape
-//! was last evaluated (see [`crate::planner::minimax::MinimaxProblem::set_skip_clear_samples`]).
+//! Which sampled shapes' obstacle rows the planning objective may keep from their last
+//! evaluation (and, where nothing else reads them, leave the shapes out): samples that certainly
+//! keep clear of every obstacle, by a bound on how far their positions can have moved since
+//! their rows were last evaluated (see
+//! [`crate::planner::minimax::MinimaxProblem::set_skip_clear_samples`]).
 
 /// Below this (in the rows' units, dimensionless lengths) a row counts as certainly below
 /// zero: above the multiplier method's boundary band (1e-9) and the planner's active-row
@@ -8,14 +10,14 @@
 /// value below it.
 const CLEAR_MARGIN: f64 = 1e-6;
 
-/// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's shape. On a rod whose
-/// positions depend on θ alone and whose energy is the constant quadratic form (planar,
-/// inextensible, weightless, fixed base, no loads), with obstacle rows only, a sample needs its
-/// shape only for its rows; and a row value `c = clearance − d(x)/L` changes by at most the
-/// boundary's displacement, which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|`
-/// ([`crate::rod::model::Model::position_bound_weights`]). A sample whose rows all have zero
-/// multipliers and whose largest row, at the coefficients of its last evaluated shape, plus
-/// that bound is below `−CLEAR_MARGIN` keeps its last rows and skips its shape.
+/// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's rows (and shape). On a
+/// rod whose positions depend on θ alone (planar, inextensible, fixed base), with obstacle rows
+/// only, a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
+/// which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|` ([`crate::rod::model::Model::position_bound_weights`]).
+/// A sample whose rows all have zero multipliers and whose largest row, at the coefficients of
+/// its last evaluated rows, plus that bound is below `−CLEAR_MARGIN` keeps its last rows. Where
+/// the energy is the constant quadratic form (weightless, no loads) and nothing else reads the
+/// shape, it skips its shape too.
 #[derive(Debug)]
 pub(super) struct ClearSamples {
     /// `ωᵢ`.
@@ -28,6 +30,11 @@ pub(super) struct ClearSamples {
     pub(super) stale: Vec<bool>,
     /// Shapes left out so far.
     pub(super) left_out: usize,
+    /// Samples whose recorded rows stood in for their rows so far.
+    pub(super) rows_kept: usize,
+    /// Whether the energy needs no shape (a weightless rod without loads), so that a kept
+    /// sample's shape may be left out too.
+    pub(super) shapes_optional: bool,
 }
 
 /// A sample's rows at the coefficients of its last evaluated shape.
@@ -41,13 +48,20 @@ struct LastRows {
 
 impl ClearSamples {
     /// Nothing recorded yet, for `samples` samples of which `interior` carry rows.
-    pub(super) fn new(omega: Vec<f64>, samples: usize, interior: usize) -> Self {
+    pub(super) fn new(
+        omega: Vec<f64>,
+        samples: usize,
+        interior: usize,
+        shapes_optional: bool,
+    ) -> Self {
         ClearSamples {
             omega,
             last: vec![None; samples],
             free: vec![false; interior],
             stale: vec![false; samples],
             left_out: 0,
+            rows_kept: 0,
+            shapes_optional,
         }
     }
 

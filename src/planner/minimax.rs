@@ -85,6 +85,9 @@ struct SampleWork {
     ha: Vec<f64>,
     /// The rows' weights (scratch).
     y: Vec<f64>,
+    /// Whether its rows at the last evaluation are its last recorded ones (its shape evaluated
+    /// all the same; see [`MinimaxProblem::set_skip_clear_samples`]).
+    rows_kept: bool,
     adj: Adjoint,
 }
 
@@ -125,6 +128,7 @@ impl MinimaxProblem {
                 gz: Vec::new(),
                 ha: Vec::new(),
                 y: vec![0.0; per],
+                rows_kept: false,
                 adj: Adjoint::new(&model),
             })
             .collect();
@@ -185,29 +189,35 @@ impl MinimaxProblem {
         }
     }
 
-    /// Turns on (or off) leaving out the shapes of samples that certainly keep clear of every
-    /// obstacle (`src/planner/clear_samples.rs`; for a planar, inextensible, weightless rod with
-    /// a fixed base, no loads, obstacle rows only — none of them a triangle mesh — and no swept
-    /// rows; otherwise it stays off). A sample qualifies while its rows' multipliers
-    /// ([`Nlp::set_multipliers`]) are zero and its largest row at its last evaluated shape, plus
-    /// the most its positions can have moved since ([`Model::position_bound_weights`]), stays
-    /// below −1e-6: it keeps those rows. While the tracking term is set every shape is
-    /// evaluated. The objective, its gradient, its Hessian and the multiplier method's steps are
-    /// the same bit for bit: only work on rows whose penalty is certainly inactive is left out.
+    /// Turns on (or off) keeping the rows of samples that certainly keep clear of every
+    /// obstacle, and leaving out their shapes where nothing else needs them
+    /// (`src/planner/clear_samples.rs`; for a planar, inextensible rod with a fixed base,
+    /// obstacle rows only — none of them a triangle mesh — and no swept rows; otherwise it
+    /// stays off). A sample qualifies while its rows' multipliers ([`Nlp::set_multipliers`]) are
+    /// zero and its largest row at its last evaluated rows, plus the most its positions can
+    /// have moved since ([`Model::position_bound_weights`]), stays below −1e-6: it keeps those
+    /// rows. Its shape is left out too only on a weightless rod without loads (whose energy
+    /// needs no shape) while neither the tracking term nor the travel term is set (they read
+    /// every shape). The objective, its gradient, its Hessian and the multiplier method's
+    /// steps are the same bit for bit: only work on rows whose penalty is certainly inactive is
+    /// left out.
     pub fn set_skip_clear_samples(&mut self, on: bool) {
         let m = &self.model;
         let eligible = on
             && self.swept.is_none()
-            && m.loads.is_empty()
-            && !m.energy_roots.is_empty()
             && self.blocks.iter().all(|b| match b {
                 Constraint::Obstacle(o) => o.obstacle.distance_is_lipschitz(),
                 _ => false,
             });
+        // The energy needs no shape: the constant quadratic form of a weightless rod.
+        let shapes_optional = m.loads.is_empty() && !m.energy_roots.is_empty();
         self.skip = match (eligible, m.position_bound_weights()) {
-            (true, Some(omega)) => {
-                Some(ClearSamples::new(omega, self.ks.len(), self.interior.len()))
-            }
+            (true, Some(omega)) => Some(ClearSamples::new(
+                omega,
+                self.ks.len(),
+                self.interior.len(),
+                shapes_optional,
+            )),
             _ => None,
         };
     }
@@ -216,6 +226,12 @@ impl MinimaxProblem {
     /// them out is off).
     pub fn shapes_left_out(&self) -> usize {
         self.skip.as_ref().map_or(0, |sk| sk.left_out)
+    }
+
+    /// How many samples' rows [`MinimaxProblem::values`] has kept from their last evaluation
+    /// (their shapes left out or not) so far.
+    pub fn rows_kept(&self) -> usize {
+        self.skip.as_ref().map_or(0, |sk| sk.rows_kept)
     }
 
     /// Evaluates sample `j`'s shape if [`MinimaxProblem::values`] left it out.
@@ -388,11 +404,14 @@ impl Nlp for MinimaxProblem {
         let per = self.rows_per_sample();
         let mut row = 0;
         // Shapes may be left out only while nothing but the rows reads them (no tracking term,
-        // no swept rows, which may have been turned on after skipping was).
+        // no swept rows, which may have been turned on after skipping was, and an energy that
+        // needs none); otherwise every shape is evaluated, and the rows of a sample certainly
+        // clear of the obstacles are still kept (not while swept rows read them).
         let light = self.targets.is_none()
             && self.swept.is_none()
             && self.travel_weight == 0.0
-            && self.skip.is_some();
+            && self.skip.as_ref().is_some_and(|sk| sk.shapes_optional);
+        let rows_only = !light && self.swept.is_none() && self.skip.is_some();
         // Which shapes stay left out (for which the samples' coefficients are needed first),
         // then, sample by sample, the coefficients (unless done here), shapes, energies and
         // rows.
@@ -430,7 +449,11 @@ impl Nlp for MinimaxProblem {
                         w.gu.iter_mut().for_each(|g| *g = 0.0);
                         let t = model.energy(&a[i], shape, objective, Some(&mut w.gu));
                         w.u = t.value(objective);
-                        if w.interior.is_some() && !left_out(skip, j0 + i) {
+                        w.rows_kept = match (skip, w.interior) {
+                            (Some(sk), Some(ii)) if rows_only => sk.clear(ii, j0 + i, &a[i]),
+                            _ => false,
+                        };
+                        if w.interior.is_some() && !w.rows_kept && !left_out(skip, j0 + i) {
                             for (b, blk) in blocks.iter().enumerate() {
                                 let rows = &mut w.rows[offsets[b]..offsets[b + 1]];
                                 blk.values(model, &a[i], shape, rows);
@@ -444,7 +467,10 @@ impl Nlp for MinimaxProblem {
             if w.interior.is_some() {
                 let rows = &mut c[row..row + per];
                 match &mut self.skip {
-                    Some(sk) if sk.stale[j] => rows.copy_from_slice(sk.rows(j)),
+                    Some(sk) if sk.stale[j] || w.rows_kept => {
+                        sk.rows_kept += 1;
+                        rows.copy_from_slice(sk.rows(j));
+                    }
                     skip => {
                         rows.copy_from_slice(&w.rows);
                         if let Some(sk) = skip {

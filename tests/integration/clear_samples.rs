@@ -1,6 +1,7 @@
-//! The planner leaves out the shapes of sampled paths that certainly keep clear of every
-//! obstacle (`MinimaxProblem::set_skip_clear_samples`): the displacement bound it relies on, and
-//! that the optimisation is the same bit for bit with and without it.
+//! The planner keeps the rows, and where it can leaves out the shapes, of sampled paths that
+//! certainly keep clear of every obstacle (`MinimaxProblem::set_skip_clear_samples`): the
+//! displacement bound it relies on, and that the optimisation is the same bit for bit with and
+//! without it.
 
 use dlo_planner::case;
 use dlo_planner::optim::{Nlp, augmented_lagrangian};
@@ -94,5 +95,39 @@ fn leaving_out_clear_samples_changes_nothing() {
         left_out * 2 > on.evaluations * nk,
         "{left_out} of {} sampled shapes left out",
         on.evaluations * nk
+    );
+}
+
+/// With the travel term, which reads every sample's end position, every shape is evaluated,
+/// but the rows of samples clear of the block are still kept from their last evaluation: the
+/// multiplier method ends at the same path, multipliers and objective bit for bit, and most
+/// samples keep their rows.
+#[test]
+fn keeping_clear_rows_with_the_travel_term_changes_nothing() {
+    let pl = planner("plan_paper_planar.json");
+    let run = |skip: bool| {
+        let mut p = pl.minimax_problem();
+        p.set_skip_clear_samples(skip);
+        p.mean_weight = 1.0;
+        p.travel_weight = 0.5;
+        p.beta = 10.0 / 2.5466;
+        let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
+        let out = augmented_lagrangian(&mut p, &mut z, None, pl.stage_options());
+        (z, out, p.shapes_left_out(), p.rows_kept(), p.ks.len())
+    };
+    let (z_on, on, left_out, kept, nk) = run(true);
+    let (z_off, off, _, none, _) = run(false);
+    assert_eq!((left_out, none), (0, 0));
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&z_on), bits(&z_off));
+    assert_eq!(bits(&on.lambda), bits(&off.lambda));
+    assert_eq!(on.f.to_bits(), off.f.to_bits());
+    assert_eq!(on.max_violation.to_bits(), off.max_violation.to_bits());
+    assert_eq!(on.status, off.status);
+    assert_eq!(on.evaluations, off.evaluations);
+    assert!(
+        kept * 2 > on.evaluations * (nk - 2),
+        "{kept} of {} samples' rows kept",
+        on.evaluations * (nk - 2)
     );
 }
