@@ -50,14 +50,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|p| p[0] * cable.length)
         .fold(f64::INFINITY, f64::min);
     println!(
-        "cable: {}, U = {:.5} J, lowest point x = {:.4} m, {}, moment balance {:.1e}",
+        "cable: {}, U = {:.5} J, lowest point x = {:.4} m, {}, moment balance {}",
         shape.status,
         shape.energy.potential(),
         sag,
         shape
             .stability
             .map_or("stability not computed".into(), |v| v.to_string()),
-        shape.balance.relative,
+        shape
+            .balance
+            .map_or("not computed".into(), |b| format!("{:.1e}", b.relative)),
     );
     for r in &shape.reactions {
         println!("  reaction at {:<24} force {:?} N", r.constraint, r.force);

@@ -256,7 +256,7 @@ fn end_shape(
         let ev = crate::statics::evaluate_shape(&mut p, &a);
         let viol = ev.max_violation;
         StaticSolution {
-            balance: ev.balance,
+            balance: Some(ev.balance),
             self_contacts: ev.self_contacts,
             energy_scaled: ev.energy.scaled(1.0 / base.model.rod.energy_unit()),
             energy: ev.energy,

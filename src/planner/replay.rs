@@ -443,10 +443,12 @@ pub fn equilibria_from(
     stretches.into_iter().flatten().collect()
 }
 
-/// The static options of tracking's solves: no stability judgement.
+/// The static options of tracking's solves: no stability judgement, no moment balance (only
+/// their shapes and multipliers are used).
 fn tracking_options(static_opts: &StaticOptions) -> StaticOptions {
     StaticOptions {
         stability: false,
+        balance: false,
         ..*static_opts
     }
 }

@@ -84,8 +84,10 @@ pub struct ShapeReport {
     pub energy: EnergyReport,
     /// Reactions at each constraint (force and moment on the rod, case units).
     pub reactions: Vec<Reaction>,
-    /// Global moment balance of the reactions, loads and gravity.
-    pub balance: crate::statics::balance::Balance,
+    /// Global moment balance of the reactions, loads and gravity (left out where not
+    /// computed: [`crate::statics::StaticOptions::balance`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balance: Option<crate::statics::balance::Balance>,
     /// Where the rod touches itself, largest force first (empty without self-contact).
     pub self_contacts: Vec<crate::statics::SelfContactForce>,
     /// Largest constraint violation (positions in units of `L`).
@@ -184,7 +186,7 @@ impl ShapeReport {
             status: "evaluated".into(),
             energy: ev.energy.into(),
             reactions: ev.reactions,
-            balance: ev.balance,
+            balance: Some(ev.balance),
             self_contacts: ev.self_contacts,
             max_violation: ev.max_violation,
             kkt_residual: Some(ev.kkt_residual),

@@ -84,6 +84,7 @@ impl StaticSettings {
                 ..AlOptions::default()
             },
             stability: self.stability,
+            balance: true,
         }
     }
 }

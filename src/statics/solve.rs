@@ -17,6 +17,9 @@ pub struct StaticOptions {
     /// Whether to compute the stability verdict (one Hessian: analytic where exact, else `2n`
     /// gradient evaluations; see [`crate::statics::stability`]).
     pub stability: bool,
+    /// Whether to compute the global moment balance ([`StaticSolution::balance`]; on a weighted
+    /// rod it integrates the positions at every quadrature node again).
+    pub balance: bool,
 }
 
 impl Default for StaticOptions {
@@ -24,6 +27,7 @@ impl Default for StaticOptions {
         StaticOptions {
             al: AlOptions::default(),
             stability: true,
+            balance: true,
         }
     }
 }
@@ -47,8 +51,9 @@ pub struct StaticSolution {
     pub kkt_residual: f64,
     /// Reactions at each constraint.
     pub reactions: Vec<Reaction>,
-    /// The global moment balance of the reactions, loads and gravity.
-    pub balance: crate::statics::balance::Balance,
+    /// The global moment balance of the reactions, loads and gravity (`None` when not
+    /// computed: [`StaticOptions::balance`]).
+    pub balance: Option<crate::statics::balance::Balance>,
     /// Where the rod touches itself and how hard (largest first; empty without self-contact).
     pub self_contacts: Vec<SelfContactForce>,
     /// `Some(true)` stable, `Some(false)` unstable, `None` marginal or not computed (see
@@ -108,7 +113,9 @@ fn finish(
     let energy_scaled = p.terms();
     let shape = p.model.evaluate(&a);
     let reactions = reactions(p, &a, &shape, &out.lambda);
-    let balance = crate::statics::balance::balance(p, &a, &shape, &out.lambda, &reactions);
+    let balance = opts
+        .balance
+        .then(|| crate::statics::balance::balance(p, &a, &shape, &out.lambda, &reactions));
     let self_contacts = self_contacts(p, &shape, &out.lambda);
     StaticSolution {
         balance,

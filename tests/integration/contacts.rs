@@ -56,6 +56,6 @@ fn chord_contacts_keep_a_rod_on_a_corner_out_of_the_obstacle() {
         chords.energy.potential(),
         points.energy.potential()
     );
-    let rel = chords.balance.relative;
+    let rel = chords.balance.expect("computed").relative;
     assert!(rel <= 1e-9, "moment balance {rel}");
 }

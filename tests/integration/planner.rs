@@ -372,7 +372,11 @@ fn replay_reports_where_it_leans_on_obstacles() {
         dlo_planner::planner::endpoints::EndPose::of(model, &a, &model.evaluate(&a).positions);
     let sol = dlo_planner::statics::solve_static(&mut pose.problem(&p.base), &a, &p.static_options);
     assert_eq!(sol.status, dlo_planner::statics::SolveStatus::Converged);
-    assert!(sol.balance.relative < 1e-9, "{:?}", sol.balance);
+    assert!(
+        sol.balance.expect("computed").relative < 1e-9,
+        "{:?}",
+        sol.balance
+    );
     let block = sol
         .reactions
         .iter()

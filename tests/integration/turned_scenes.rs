@@ -199,7 +199,7 @@ fn heavy_cable_turned_about_the_vertical_is_the_same() {
     for pairs in [2, 4, 8, 16] {
         let mut v = base.clone();
         v["discretisation"]["basis_pairs"] = pairs.into();
-        let b = solve(&v).1.balance.relative;
+        let b = solve(&v).1.balance.expect("computed").relative;
         assert!(b < last, "{pairs} pairs: balance {b} after {last}");
         last = b;
     }
@@ -412,7 +412,7 @@ fn frame_and_legendre_basis_balance_3d_shapes() {
     let q = turn([1.0, 0.0, 0.0], 0.3);
     let legendre = |pairs: usize| json!({ "discretisation": { "basis_pairs": pairs, "panels": 32, "basis": "legendre" } });
     let cable = clamped(rod, f0, [0.0, 0.0, 0.3], f1, q, legendre(8));
-    let b = solve(&cable).1.balance.relative;
+    let b = solve(&cable).1.balance.expect("computed").relative;
     assert!(b < 1e-6, "cable: {b}");
     let path = format!(
         "{}/planning_cases/self_contact_crossed_loop.json",
@@ -420,6 +420,6 @@ fn frame_and_legendre_basis_balance_3d_shapes() {
     );
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     v["discretisation"] = legendre(12)["discretisation"].clone();
-    let b = solve(&v).1.balance.relative;
+    let b = solve(&v).1.balance.expect("computed").relative;
     assert!(b < 1e-5, "crossed loop: {b}");
 }

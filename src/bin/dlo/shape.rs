@@ -108,12 +108,13 @@ pub(crate) fn print_report(r: &ShapeReport, json: bool) {
             re.moment[2]
         );
     }
-    let b = &r.balance;
-    let _ = writeln!(
-        o,
-        "  moment balance residual [{:+.3e}, {:+.3e}, {:+.3e}] ({:.1e} of the largest moment)",
-        b.moment_residual[0], b.moment_residual[1], b.moment_residual[2], b.relative
-    );
+    if let Some(b) = &r.balance {
+        let _ = writeln!(
+            o,
+            "  moment balance residual [{:+.3e}, {:+.3e}, {:+.3e}] ({:.1e} of the largest moment)",
+            b.moment_residual[0], b.moment_residual[1], b.moment_residual[2], b.relative
+        );
+    }
     if let Some(c) = r.self_contacts.first() {
         let f = (c.force[0].powi(2) + c.force[1].powi(2) + c.force[2].powi(2)).sqrt();
         let _ = writeln!(
