@@ -940,21 +940,21 @@ mod tests {
     #[test]
     fn a_feasible_start_keeps_its_penalty_when_told_to() {
         let (xs, ls) = Spread::uniform(1.0).solution();
+        let opts = |hold: bool| AlOptions {
+            second_order: false,
+            rho_initial: 1e2,
+            feasibility_tol: 1e-6,
+            optimality_tol: 1e-5,
+            hold_penalty_when_feasible: hold,
+            ..AlOptions::default()
+        };
         let run = |hold: bool| {
             let mut t = [1.0; 6];
             t[0] += 0.05;
             t[1] -= 0.05;
             let mut q = Spread { t };
             let mut x = xs.clone();
-            let opts = AlOptions {
-                second_order: false,
-                rho_initial: 1e2,
-                feasibility_tol: 1e-6,
-                optimality_tol: 1e-5,
-                hold_penalty_when_feasible: hold,
-                ..AlOptions::default()
-            };
-            let out = augmented_lagrangian(&mut q, &mut x, Some(&[ls]), opts);
+            let out = augmented_lagrangian(&mut q, &mut x, Some(&[ls]), opts(hold));
             assert_spread_solved(&q, &x, &out);
             (out.rho, out.outer_iterations, out.penalty_held)
         };
@@ -968,15 +968,7 @@ mod tests {
         let cold = |hold: bool| {
             let mut q = Spread::uniform(1.0);
             let mut x = vec![0.0; 6];
-            let opts = AlOptions {
-                second_order: false,
-                rho_initial: 1e2,
-                feasibility_tol: 1e-6,
-                optimality_tol: 1e-5,
-                hold_penalty_when_feasible: hold,
-                ..AlOptions::default()
-            };
-            let out = augmented_lagrangian(&mut q, &mut x, None, opts);
+            let out = augmented_lagrangian(&mut q, &mut x, None, opts(hold));
             (x, out)
         };
         let ((xh, oh), (xr, or)) = (cold(true), cold(false));

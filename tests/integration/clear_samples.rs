@@ -4,7 +4,7 @@
 //! without it.
 
 use dlo_planner::case;
-use dlo_planner::optim::{Nlp, augmented_lagrangian};
+use dlo_planner::optim::{AlOutcome, Nlp, augmented_lagrangian};
 use dlo_planner::planner::Planner;
 use std::path::Path;
 
@@ -68,29 +68,42 @@ fn position_bound_weights_bound_the_displacement() {
 /// path) ends at the same path, multipliers and objective bit for bit
 /// whether the problem leaves out the shapes of samples clear of the block or not — and it
 /// does leave out most of them.
-#[test]
-fn leaving_out_clear_samples_changes_nothing() {
-    let pl = planner("plan_paper_planar.json");
-    let run = |skip: bool| {
-        let mut p = pl.minimax_problem();
-        p.set_skip_clear_samples(skip);
-        p.mean_weight = 1.0;
-        p.travel_weight = 0.0;
-        p.beta = 10.0 / 2.5466;
-        let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
-        let out = augmented_lagrangian(&mut p, &mut z, None, pl.stage_options());
-        (z, out, p.shapes_left_out(), p.ks.len())
-    };
-    let (z_on, on, left_out, nk) = run(true);
-    let (z_off, off, none, _) = run(false);
-    assert_eq!(none, 0);
+/// The first sharpness stage of the paper's planning problem, from a perturbed straight path,
+/// with the travel term's weight `travel`, keeping clear samples' rows (and shapes) or not:
+/// the path, the outcome, the shapes left out, the rows kept and the number of samples.
+fn first_stage(
+    pl: &Planner,
+    skip: bool,
+    travel: f64,
+) -> (Vec<f64>, AlOutcome, usize, usize, usize) {
+    let mut p = pl.minimax_problem();
+    p.set_skip_clear_samples(skip);
+    p.mean_weight = 1.0;
+    p.travel_weight = travel;
+    p.beta = 10.0 / 2.5466;
+    let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
+    let out = augmented_lagrangian(&mut p, &mut z, None, pl.stage_options());
+    (z, out, p.shapes_left_out(), p.rows_kept(), p.ks.len())
+}
+
+/// The same path, multipliers, objective, violation, status and evaluations to the bit.
+fn assert_same_run(z_on: &[f64], on: &AlOutcome, z_off: &[f64], off: &AlOutcome) {
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    assert_eq!(bits(&z_on), bits(&z_off));
+    assert_eq!(bits(z_on), bits(z_off));
     assert_eq!(bits(&on.lambda), bits(&off.lambda));
     assert_eq!(on.f.to_bits(), off.f.to_bits());
     assert_eq!(on.max_violation.to_bits(), off.max_violation.to_bits());
     assert_eq!(on.status, off.status);
     assert_eq!(on.evaluations, off.evaluations);
+}
+
+#[test]
+fn leaving_out_clear_samples_changes_nothing() {
+    let pl = planner("plan_paper_planar.json");
+    let (z_on, on, left_out, _, nk) = first_stage(&pl, true, 0.0);
+    let (z_off, off, none, _, _) = first_stage(&pl, false, 0.0);
+    assert_eq!(none, 0);
+    assert_same_run(&z_on, &on, &z_off, &off);
     assert!(
         left_out * 2 > on.evaluations * nk,
         "{left_out} of {} sampled shapes left out",
@@ -105,26 +118,10 @@ fn leaving_out_clear_samples_changes_nothing() {
 #[test]
 fn keeping_clear_rows_with_the_travel_term_changes_nothing() {
     let pl = planner("plan_paper_planar.json");
-    let run = |skip: bool| {
-        let mut p = pl.minimax_problem();
-        p.set_skip_clear_samples(skip);
-        p.mean_weight = 1.0;
-        p.travel_weight = 0.5;
-        p.beta = 10.0 / 2.5466;
-        let mut z: Vec<f64> = wave(p.n(), 0.9).iter().map(|v| 0.01 * v).collect();
-        let out = augmented_lagrangian(&mut p, &mut z, None, pl.stage_options());
-        (z, out, p.shapes_left_out(), p.rows_kept(), p.ks.len())
-    };
-    let (z_on, on, left_out, kept, nk) = run(true);
-    let (z_off, off, _, none, _) = run(false);
+    let (z_on, on, left_out, kept, nk) = first_stage(&pl, true, 0.5);
+    let (z_off, off, _, none, _) = first_stage(&pl, false, 0.5);
     assert_eq!((left_out, none), (0, 0));
-    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    assert_eq!(bits(&z_on), bits(&z_off));
-    assert_eq!(bits(&on.lambda), bits(&off.lambda));
-    assert_eq!(on.f.to_bits(), off.f.to_bits());
-    assert_eq!(on.max_violation.to_bits(), off.max_violation.to_bits());
-    assert_eq!(on.status, off.status);
-    assert_eq!(on.evaluations, off.evaluations);
+    assert_same_run(&z_on, &on, &z_off, &off);
     assert!(
         kept * 2 > on.evaluations * (nk - 2),
         "{kept} of {} samples' rows kept",
