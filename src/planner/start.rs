@@ -398,9 +398,8 @@ impl Planner {
         let better = |a: &Verification, b: &Verification| {
             (a.collision_free(tol), -a.u_max) > (b.collision_free(tol), -b.u_max)
         };
-        let mut run = run;
-        let first_stage = run.first_stage.take();
         let mut chosen = run;
+        let first_stage = chosen.first_stage.take();
         let mut ver = check(&chosen.z);
         let mut ks = uniform.to_vec();
         let mut added = Vec::new();

@@ -116,6 +116,19 @@ impl Model {
         }
     }
 
+    /// Gravity's θθ entry of node `q`'s local Hessian: `−wg (1+ε) sθ cφ`, or `−wg (1+ε) u·ζ`
+    /// for the vertical `u` of an angles' frame.
+    #[inline(always)]
+    fn gravity_theta_theta(&self, shape: &Shape, q: usize, up: Option<[f64; 3]>) -> f64 {
+        let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
+        let one = 1.0 + shape.eps[q];
+        let wg = self.wg[q];
+        match up {
+            Some(u) => -wg * one * (u[0] * st * cp + u[1] * st * sp + u[2] * ct),
+            None => -wg * one * st * cp,
+        }
+    }
+
     /// The constant part of the energy Hessian: `Σ_q wf θ'θ' + wt ψ'ψ' + we εε` terms.
     pub(crate) fn assemble_constant_hessian(&self) -> Vec<f64> {
         let n = self.n();
@@ -163,18 +176,7 @@ impl Model {
             // (the same value, and the same sums in node order, as the assembly below).
             let up = self.up();
             let terms: Vec<(usize, f64)> = (0..self.nodes())
-                .map(|q| {
-                    let (st, ct, sp, cp) = (shape.sth[q], shape.cth[q], shape.sph[q], shape.cph[q]);
-                    let one = 1.0 + shape.eps[q];
-                    let wg = self.wg[q];
-                    let hth = if let Some(u) = up {
-                        let f = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
-                        -wg * one * f
-                    } else {
-                        -wg * one * st * cp
-                    };
-                    (q, hth * scale)
-                })
+                .map(|q| (q, self.gravity_theta_theta(shape, q, up) * scale))
                 .filter(|&(_, w)| w != 0.0)
                 .collect();
             self.add_theta_outer(&terms, h);
@@ -187,15 +189,13 @@ impl Model {
                 let (wf, wt, wg) = (self.wf[q], self.wt[q], self.wg[q]);
                 let omega = dph * ct + dps;
                 // Gravity: wg (1+ε) sθ cφ; wg (1+ε) u·ζ for the vertical `u` of an angles' frame.
+                hq[TH][TH] = self.gravity_theta_theta(shape, q, up);
                 if let Some(u) = up {
-                    let f = u[0] * st * cp + u[1] * st * sp + u[2] * ct;
-                    hq[TH][TH] = -wg * one * f;
                     hq[TH][PH] = wg * one * (-u[0] * ct * sp + u[1] * ct * cp);
                     hq[PH][PH] = -wg * one * (u[0] * st * cp + u[1] * st * sp);
                     hq[TH][EPS] = wg * (u[0] * ct * cp + u[1] * ct * sp - u[2] * st);
                     hq[PH][EPS] = wg * (-u[0] * st * sp + u[1] * st * cp);
                 } else {
-                    hq[TH][TH] = -wg * one * st * cp;
                     hq[TH][PH] = -wg * one * ct * sp;
                     hq[PH][PH] = -wg * one * st * cp;
                     hq[TH][EPS] = wg * ct * cp;
@@ -382,7 +382,8 @@ impl Model {
         let n = self.n();
         let nb = self.nb();
         let ps = &self.mesh.panel_start;
-        if !self.e_lanes.is_empty() && n == nb {
+        // (`n = nb`: a planar inextensible rod with a fixed base has θ's coefficients only.)
+        if !self.e_lanes.is_empty() {
             return self.planar_gauss_newton_rows(shape, c, h);
         }
         let mut jx = vec![0.0; n];

@@ -50,7 +50,7 @@ impl Obstacle {
             // SAFETY: the first `whole` of each are written just above.
             let c = xyz.each_ref().map(|x| unsafe { written(&x[..whole]) });
             let mut redo = [false; BATCH];
-            let done = match &self.shape {
+            match &self.shape {
                 // SAFETY (all three): the processor has AVX2 (checked above).
                 ObstacleShape::Ball(b) => unsafe { x86::ball(b.radius, c, out) },
                 ObstacleShape::Capsule(cap) => {
@@ -62,16 +62,15 @@ impl Obstacle {
                     let h = cb.half_extents;
                     unsafe { x86::cuboid([h.x, h.y, h.z], c, out, &mut redo) }
                 }
-                _ => false,
-            };
-            if done {
-                for (i, (o, p)) in out[..n].iter_mut().zip(points).enumerate() {
-                    if i >= whole || redo[i] {
-                        *o = self.signed_distance_value(*p);
-                    }
-                }
-                return;
+                // (Kept out by the check above.) Every point by the one-point path.
+                _ => redo.fill(true),
             }
+            for (i, (o, p)) in out[..n].iter_mut().zip(points).enumerate() {
+                if i >= whole || redo[i] {
+                    *o = self.signed_distance_value(*p);
+                }
+            }
+            return;
         }
         for (o, p) in out[..n].iter_mut().zip(points) {
             *o = self.signed_distance_value(*p);
@@ -137,7 +136,7 @@ mod x86 {
     /// Balls of radius `r` about the local origin (`Ball::project_local_point`, not solid),
     /// for the points of local coordinates `c`, four at a time, into `out`.
     #[target_feature(enable = "avx2")]
-    pub(super) fn ball(r: f64, c: [&[f64]; 3], out: &mut [f64]) -> bool {
+    pub(super) fn ball(r: f64, c: [&[f64]; 3], out: &mut [f64]) {
         let (vr, rr) = (_mm256_set1_pd(r), _mm256_set1_pd(r * r));
         for (i, o) in out[..c[0].len()].chunks_exact_mut(4).enumerate() {
             let p = point(c, 4 * i);
@@ -146,7 +145,6 @@ mod x86 {
             let s = _mm256_div_pd(vr, _mm256_sqrt_pd(d2));
             o.copy_from_slice(&signed(p, p.map(|c| _mm256_mul_pd(c, s)), inside));
         }
-        true
     }
 
     /// A capsule of radius `r` about the segment `ends` (`project_capsule`), as [`ball`];
@@ -159,7 +157,7 @@ mod x86 {
         c: [&[f64]; 3],
         out: &mut [f64],
         redo: &mut [bool],
-    ) -> bool {
+    ) {
         let (a, b) = (ends[0], ends[1]);
         let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let sqnab = (ab[0] * ab[0]) + (ab[1] * ab[1]) + (ab[2] * ab[2]);
@@ -205,13 +203,12 @@ mod x86 {
                 *r = !ok;
             }
         }
-        true
     }
 
     /// Boxes with half extents `h` about the local origin (`project_cuboid`), as [`ball`];
     /// `redo` marks the points inside, which need the one-point path.
     #[target_feature(enable = "avx2")]
-    pub(super) fn cuboid(h: [f64; 3], c: [&[f64]; 3], out: &mut [f64], redo: &mut [bool]) -> bool {
+    pub(super) fn cuboid(h: [f64; 3], c: [&[f64]; 3], out: &mut [f64], redo: &mut [bool]) {
         let zero = _mm256_setzero_pd();
         let (lo, hi) = (h.map(|h| _mm256_set1_pd(-h)), h.map(|h| _mm256_set1_pd(h)));
         let four = out[..c[0].len()]
@@ -232,7 +229,6 @@ mod x86 {
             o.copy_from_slice(&signed(p, proj, zero));
             redo.copy_from_slice(&lanes(inside));
         }
-        true
     }
 }
 
