@@ -227,10 +227,10 @@ impl Model {
     /// The node terms and, with `grad`, their sums for `nb ≤ 4 C` basis functions, with
     /// (`SPATIAL`) or without the φ and ψ fields and with (`EXT`) or without ε (a planar rod
     /// here is extensible or has an angles' frame). The same operations in the same order as
-    /// the loop over [`Model::node_values`] and [`Model::add_node_sums`], so the same result bit for bit, but
-    /// a block of nodes at a time: first every node's terms and factors side by side (no node
-    /// waits for another, so the loop runs on vectors), then the energies added up in node
-    /// order, then the factors into sums kept in registers.
+    /// the loop over [`Model::node_values`] and [`Model::add_node_sums`], so the same result
+    /// bit for bit, but a block of nodes at a time: first every node's terms and factors side
+    /// by side (no node waits for another, so the loop runs on vectors), then the energies
+    /// added up in node order, then the factors into sums kept in registers.
     #[inline(always)]
     fn fused_node_sums<const C: usize, const SPATIAL: bool, const EXT: bool>(
         &self,
