@@ -278,12 +278,16 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
     on_outer: &mut dyn FnMut(&OuterIterate, &P) -> bool,
 ) -> AlOutcome {
     let (n, m) = (p.n(), p.m());
-    // A run started without multipliers on a stable equilibrium holds on to it.
+    let use_newton = opts.second_order && p.has_hessian();
+    // A run started on a stable equilibrium holds on to it: without multipliers, where the
+    // least-squares ones make it one; with them (Newton's runs, the only ones that meet
+    // saddles), where they do.
     let seeded = lambda0
         .is_none()
         .then(|| equilibrium_multipliers(p, x, &opts))
         .flatten();
-    let on_equilibrium = seeded.is_some();
+    let on_equilibrium = seeded.is_some()
+        || (use_newton && lambda0.is_some_and(|l| on_stable_equilibrium(p, x, l, &opts)));
     let mut lambda = match (lambda0, seeded) {
         (Some(l), _) => l.to_vec(),
         (None, Some(l)) => l,
@@ -301,7 +305,6 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
     let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
     let mut sw = vec![0.0; m];
-    let use_newton = opts.second_order && p.has_hessian();
     // Second-order multiplier steps until one outer iteration fails to cut the violation enough
     // (inconsistent constraints make the dual unbounded, and its Newton steps diverge).
     let mut dual_ok = use_newton && opts.newton_multipliers;
@@ -550,6 +553,27 @@ fn equilibrium_multipliers<P: Nlp>(p: &mut P, x: &[f64], opts: &AlOptions) -> Op
         return None;
     }
     Some(lam)
+}
+
+/// Whether `x` with the multipliers `lambda` is a stable (or neutral) equilibrium within the
+/// tolerances [`equilibrium_multipliers`] takes: feasible, `‖∇f + Jᵀλ‖∞ ≤ NEAR_EQUILIBRIUM ·
+/// max(1, ‖∇f‖∞)`, and not curving down along the constraints. A warm start from a converged
+/// solve of the same problem (a replay's first step, on the start shape) is one.
+fn on_stable_equilibrium<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64], opts: &AlOptions) -> bool {
+    let m = p.m();
+    if m == 0 || lambda.len() != m {
+        return false;
+    }
+    let mut c = vec![0.0; m];
+    p.values(x, &mut c);
+    if violation(p, &c) > opts.feasibility_tol {
+        return false;
+    }
+    let mut g = vec![0.0; p.n()];
+    p.gradient(x, &vec![0.0; m], &mut g);
+    let scale = inf_norm(&g).max(1.0);
+    p.gradient(x, lambda, &mut g);
+    inf_norm(&g) <= NEAR_EQUILIBRIUM * scale && !unstable_along_constraints(p, x, lambda)
 }
 
 /// The reduced Hessian's smallest eigenvalue over its largest magnitude (at least 1) at
@@ -976,5 +1000,79 @@ mod tests {
         assert_eq!(xh, xr);
         assert_eq!((oh.rho, oh.evaluations), (or.rho, or.evaluations));
         assert_eq!(oh.lambda, or.lambda);
+    }
+
+    /// min −2x² + y + 0.3x on the unit circle: a stable minimum P near (0.96, −0.27) where the
+    /// Lagrangian curves down across the circle (−4 + 2λ < 0 along x), and a lower one Q near
+    /// (−0.97, −0.23); with the exact Hessian.
+    struct Bent;
+    impl Nlp for Bent {
+        fn n(&self) -> usize {
+            2
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn sense(&self, _i: usize) -> Sense {
+            Sense::Equal
+        }
+        fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
+            c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
+            -2.0 * x[0] * x[0] + x[1] + 0.3 * x[0]
+        }
+        fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
+            g[0] = -4.0 * x[0] + 0.3 + 2.0 * y[0] * x[0];
+            g[1] = 1.0 + 2.0 * y[0] * x[1];
+        }
+        fn has_hessian(&self) -> bool {
+            true
+        }
+        fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
+            let j = [2.0 * x[0], 2.0 * x[1]];
+            h[0] += -4.0 + 2.0 * y[0];
+            h[3] += 2.0 * y[0];
+            for a in 0..2 {
+                for b in 0..2 {
+                    h[2 * a + b] += s[0] * j[a] * j[b];
+                }
+            }
+        }
+    }
+
+    /// A run warm-started on a converged stable minimum with its own multiplier (a replay's
+    /// first step on its start shape) returns it unchanged, even where the penalty is far too
+    /// small to make Φ convex there (Φ has a saddle at P): the problem curves up along the
+    /// circle, so the negative curvature is the penalty's. P itself is checked against the
+    /// stationarity of f(cos t, sin t): cos t (4 sin t + 1) − 0.3 sin t = 0.
+    #[test]
+    fn a_warm_start_on_a_stable_minimum_stays_there() {
+        let mut x = vec![0.95, -0.3];
+        let out = augmented_lagrangian(&mut Bent, &mut x, None, AlOptions::default());
+        assert_eq!(out.status, AlStatus::Converged);
+        let t = x[1].atan2(x[0]);
+        let dfdt = t.cos() * (4.0 * t.sin() + 1.0) - 0.3 * t.sin();
+        assert!(
+            dfdt.abs() < 1e-7 && (x[0] - 0.9625).abs() < 1e-3,
+            "{x:?} {dfdt}"
+        );
+        // −4 + 2λ < 0: with ρ = 0.01 Φ curves down across the circle at P.
+        let lambda = out.lambda.clone();
+        assert!(
+            -4.0 + 2.0 * lambda[0] + 0.01 * 4.0 * x[0] * x[0] < 0.0,
+            "{lambda:?}"
+        );
+        let opts = AlOptions {
+            rho_initial: 0.01,
+            ..AlOptions::default()
+        };
+        let mut y = x.clone();
+        let again = augmented_lagrangian(&mut Bent, &mut y, Some(&lambda), opts);
+        assert_eq!(again.status, AlStatus::Converged);
+        assert_eq!(y, x);
+        // From the same point without the multiplier the run starts off equilibrium and
+        // leaves P for the lower minimum Q.
+        let mut z = x.clone();
+        let off = augmented_lagrangian(&mut Bent, &mut z, Some(&[0.0]), opts);
+        assert!(z[0] < -0.9, "{z:?} {off:?}");
     }
 }

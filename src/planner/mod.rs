@@ -146,6 +146,16 @@ pub struct Planner {
     pub goal: StaticSolution,
     /// Rows of the fixed conditions that are linear in the coefficients.
     pub linear_rows: Vec<Vec<f64>>,
+    /// `base` as the replays hold the rod: as the start shape is held, with the obstacle
+    /// contacts on the chords between the sample points, [`Planner::start_contacts`] off the
+    /// obstacles, where the start shape needed that to rest on an obstacle clear of it (its
+    /// contacts at the points dipped into it between them on the verification grid); else
+    /// `base` itself. A replay's first solve then starts on an equilibrium of its own problem.
+    pub held: StaticProblem,
+    /// How far (units of L) the start shape's contacts are held off the obstacles on the
+    /// chords between the sample points, where it needed the chords; `None` where it rests on
+    /// its sample points (or touches nothing).
+    pub start_contacts: Option<f64>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
@@ -225,7 +235,7 @@ fn classify(p: &StaticProblem, safety: f64) -> (Vec<Vec<f64>>, Vec<Constraint>) 
 /// The start or goal shape: `end`'s coefficients as given, or the static solve of its pose,
 /// started from its coefficients, else (a 3D end with all three angles) from a shape bent
 /// from the held frame `held` (see [`held_frame`]) towards its own, else from the case's
-/// initial shape.
+/// initial shape; with how its obstacle contacts are held ([`on_chords_if_dipping`]).
 fn end_shape(
     problem: &PlanProblem,
     which: &'static str,
@@ -234,7 +244,7 @@ fn end_shape(
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
     coincide_tolerance: f64,
-) -> Result<StaticSolution, PlanSetupError> {
+) -> Result<(StaticSolution, Option<f64>), PlanSetupError> {
     let seed = end_angles(end)
         .filter(|_| problem.statics.model.layout.spatial)
         .map(|e| (held, e));
@@ -247,7 +257,7 @@ fn end_shape(
             .map(|&(f, v)| (Angle::Field(f), v))
             .collect(),
     };
-    let sol = if !end.is_pose() {
+    let (sol, contacts) = if !end.is_pose() {
         let a = end.shape.clone().expect("validated: shape or pose");
         // Held at its own end pose, as the replay holds it: the least-squares multipliers then
         // include the end's reactions, and they warm-start the replay's first solve row for row.
@@ -255,7 +265,7 @@ fn end_shape(
         let mut p = held.problem(base);
         let ev = crate::statics::evaluate_shape(&mut p, &a);
         let viol = ev.max_violation;
-        StaticSolution {
+        let sol = StaticSolution {
             balance: Some(ev.balance),
             self_contacts: ev.self_contacts,
             energy_scaled: ev.energy.scaled(1.0 / base.model.rod.energy_unit()),
@@ -279,7 +289,8 @@ fn end_shape(
             outer_iterations: 0,
             evaluations: 1,
             a,
-        }
+        };
+        (sol, None)
     } else {
         let a0 = match (&end.shape, seed) {
             (Some(a), _) => a.clone(),
@@ -316,7 +327,7 @@ fn end_shape(
             message: msg,
         });
     }
-    Ok(sol)
+    Ok((sol, contacts))
 }
 
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
@@ -326,7 +337,8 @@ fn end_shape(
 /// dips (the rod bulges into the obstacle between the points), the pose solved on the chords
 /// held off the obstacles by [`hold_off_margin`] (of the plan's `coincide_tolerance`), when
 /// that converges clear. An end resting on an obstacle is a legal end of a path only when the
-/// verification grid finds it clear.
+/// verification grid finds it clear. Returned with how its contacts are held: `None` at the
+/// sample points, `Some(margin)` on the chords, `margin` (units of L) off the obstacles.
 fn on_chords_if_dipping(
     problem: &PlanProblem,
     pose: &EndPose,
@@ -334,38 +346,38 @@ fn on_chords_if_dipping(
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
     coincide_tolerance: f64,
-) -> StaticSolution {
+) -> (StaticSolution, Option<f64>) {
     let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
     let depth = |a: &[f64]| {
         verify::shape_worst_clearance(fine, &problem.obstacles, a)
             .map_or(f64::INFINITY, |w| w.clearance)
     };
     if sol.status != SolveStatus::Converged || depth(&sol.a) >= -tol {
-        return sol;
+        return (sol, None);
     }
     let Some(chords) = equilibrium_plan::on_chords(&problem.statics) else {
-        return sol;
+        return (sol, None);
     };
     let again = solve_static(&mut pose.problem(&chords), &sol.a, opts);
     if again.status != SolveStatus::Converged {
-        return sol;
+        return (sol, None);
     }
     let d = depth(&again.a);
     if d >= -tol {
-        return again;
+        return (again, Some(0.0));
     }
     // Still inside (the rod bulges into the obstacle between the points): held off it by
     // twice that depth, as the replayed equilibria are ([`Planner::judge_path`]).
     let length = problem.statics.model.rod.length;
     let Some(margin) = hold_off_margin(-d, length, coincide_tolerance) else {
-        return sol;
+        return (sol, None);
     };
     let held = equilibrium_plan::held_off(&problem.statics, margin);
     let off = solve_static(&mut pose.problem(&held), &again.a, opts);
     if off.status == SolveStatus::Converged && depth(&off.a) >= -tol {
-        off
+        (off, Some(margin))
     } else {
-        sol
+        (sol, None)
     }
 }
 
@@ -602,13 +614,17 @@ impl Planner {
     ) -> Judged {
         let t = std::time::Instant::now();
         let mut rec = Recorder::new(observer);
-        let mut rep = self.replay_under(&self.base, path, z, early_stop, &mut rec);
+        let mut rep = self.replay_under(&self.held, path, z, early_stop, &mut rec);
         let workspace = self.workspace_check(path, z);
         let within = workspace.is_none_or(|w| w.within);
         let as_planned = planned && rep.coincide;
         let mut equilibrium_plan =
             (!as_planned && self.settings.equilibrium_plans && !self.stopped())
-                .then(|| self.equilibrium_plan(&self.base, path, z, &rep, fine, &mut rec));
+                .then(|| self.equilibrium_plan(&self.held, path, z, &rep, fine, &mut rec));
+        if let Some(ep) = equilibrium_plan.as_mut() {
+            let l = self.base.model.rod.length;
+            ep.contact_margin = self.start_contacts.filter(|&m| m > 0.0).map(|m| m * l);
+        }
         let mut shapes = rec.into_shapes();
         // Equilibria that dip between the solves' contact points: replayed again with the
         // contacts on the chords between them, and where they still dip, held off the obstacles
@@ -625,7 +641,7 @@ impl Planner {
                 (again, plan, rec.into_shapes())
             };
             let mut depth = ep.min_clearance.map_or(0.0, |c| -c);
-            if let Some(chords) = equilibrium_plan::on_chords(&self.base) {
+            if let Some(chords) = equilibrium_plan::on_chords(&self.held) {
                 let (again, on_chords, recorded) = attempt(&chords);
                 if on_chords.executable {
                     *ep = on_chords;
@@ -646,6 +662,8 @@ impl Planner {
             let margin = hold_off_margin(depth, l, self.settings.coincide_tolerance)
                 .filter(|_| !ep.executable && !self.stopped());
             if let Some(margin) = margin {
+                // On top of the margin the start shape already needed.
+                let margin = margin + self.start_contacts.unwrap_or(0.0);
                 let (again, held, recorded) =
                     attempt(&equilibrium_plan::held_off(&self.base, margin));
                 if held.executable {
@@ -742,7 +760,7 @@ impl Planner {
         resolve(&mut start_end, "start", held.0)?;
         // The verification grid, on which an end shape resting on an obstacle must be clear.
         let fine = fine_model(model, settings.verify_s_samples, 4);
-        let start = end_shape(
+        let (start, start_contacts) = end_shape(
             &problem,
             "start",
             &start_end,
@@ -752,7 +770,7 @@ impl Planner {
             settings.coincide_tolerance,
         )?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
-        let goal = end_shape(
+        let (goal, _) = end_shape(
             &problem,
             "goal",
             &goal_end,
@@ -765,7 +783,15 @@ impl Planner {
             check_workspace(model, w, [("start", &start), ("goal", &goal)])?;
         }
         let (linear_rows, _) = classify(&problem.statics, 0.0);
+        // The replays hold the rod as the start shape is held, so that their first step
+        // starts on an equilibrium of its own problem.
+        let held = start_contacts.map_or_else(
+            || problem.statics.clone(),
+            |margin| equilibrium_plan::held_off(&problem.statics, margin),
+        );
         Ok(Planner {
+            held,
+            start_contacts,
             base: problem.statics,
             obstacles: problem.obstacles,
             static_options,

@@ -61,7 +61,7 @@ impl Planner {
         let z = vec![0.0; path.n_vars()];
         let mut rec = Recorder::new(observer);
         // Only a replay that coincides makes it the plan: it ends where it departs.
-        let replay = self.replay_under(&self.base, &path, &z, EarlyStop::Departure, &mut rec);
+        let replay = self.replay_under(&self.held, &path, &z, EarlyStop::Departure, &mut rec);
         let workspace = self.workspace_check(&path, &z);
         let within = workspace.is_none_or(|w| w.within);
         (replay.coincide && within && !self.stopped()).then(|| Judged {

@@ -59,3 +59,69 @@ fn chord_contacts_keep_a_rod_on_a_corner_out_of_the_obstacle() {
     let rel = chords.balance.expect("computed").relative;
     assert!(rel <= 1e-9, "moment balance {rel}");
 }
+
+/// A generated 3D problem (the suite's generator, seed 41, ten 3D problems after twenty planar
+/// ones: `spatial_2`) whose start pose presses the cable onto the mesh cube: held at its sample
+/// points the start shape dips into the cube between them, so it is solved with the contacts on
+/// the chords, where it rests on the cube (clearance 4e-5 L on the verification grid). The
+/// replays hold the rod the same way, and the replay's first step, solved from the start shape
+/// and its own multipliers at its own end pose, stays on it. With the contacts at the points
+/// (measured: the replay under `p.base`), and on the chords when a warm-started solve still
+/// stepped off every saddle of the augmented function, the first step went to another
+/// equilibrium (U 14.33 and 5.83 instead of 8.36, 0.26 L away at k = 0), and the verdict called
+/// the start shape one its end pose does not hold.
+#[test]
+fn a_start_resting_on_an_obstacle_is_where_the_replay_starts() {
+    use dlo_planner::optim::Nlp;
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::endpoints::EndPose;
+    use dlo_planner::statics::solve_static_warm;
+    let text = r#"{"name": "spatial_41_2", "planar": false,
+      "rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.77, "radius": 0.01},
+      "constraints": [{"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}],
+      "obstacles": [{"name": "o0", "shape": {"type": "triangle_mesh", "obj": "meshes/cube.obj", "scale": 0.25590206247483466}, "position": [-0.05051621964152547, 0.046029931293506327, 0.7620766829118648]}],
+      "plan": {"start": {"position": [-0.2270934885855953, -0.11898475530026731, 0.7327632042096668], "tangent": [-0.6568973928145647, -0.3441788491085004, 0.6708403201506119], "twist": 0.34531151489530787},
+               "goal": {"position": [0.24454164804529685, 0.24291432476232083, 0.5194825293426226], "tangent": [0.6159470151547449, 0.6118481431349766, 0.49623696382297205], "twist": -0.388309232086258}}}"#;
+    let root = env!("CARGO_MANIFEST_DIR");
+    let path = std::path::Path::new(root).join("planning_cases/spatial_41_2.json");
+    let c = dlo_planner::case::parse(text, &path).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    // The start rests on the chords, not held off them.
+    assert_eq!(p.start_contacts, Some(0.0));
+    let start = &p.start;
+    assert_eq!(start.status, SolveStatus::Converged);
+    assert_eq!(start.stable, Some(true));
+    // Its own end pose on the replays' problem, solved from it with its multipliers: the same
+    // shape to the bit, the same energy.
+    let shape = p.base.model.evaluate(&start.a);
+    let mut held = EndPose::of(&p.base.model, &start.a, &shape.positions).problem(&p.held);
+    assert_eq!(held.m(), start.lambda.len());
+    let again = solve_static_warm(&mut held, &start.a, &start.lambda, &p.static_options);
+    assert_eq!(again.status, SolveStatus::Converged);
+    assert_eq!(again.a, start.a);
+    // The replay of the straight path (stopped where it departs) starts on the start shape.
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let replay = |base| {
+        dlo_planner::planner::replay::replay(
+            base,
+            start,
+            &path,
+            &z,
+            dlo_planner::planner::replay::ReplayOptions {
+                early_stop: dlo_planner::planner::replay::EarlyStop::Departure,
+                ..p.settings.replay()
+            },
+            &p.static_options,
+            &mut dlo_planner::planner::observer::Silent,
+            &std::sync::atomic::AtomicBool::new(false),
+        )
+    };
+    let rep = replay(&p.held);
+    assert!(rep.start_held());
+    assert!(
+        rep.start_deviation_over_l < 1e-9,
+        "{}",
+        rep.start_deviation_over_l
+    );
+}

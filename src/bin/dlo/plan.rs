@@ -76,7 +76,10 @@ pub(crate) fn run_plan(
         Err(code) => return code,
     };
     let t0 = Instant::now();
+    // Whether the start was given a shape (else solved for its pose alone).
+    let mut start_written = false;
     let built = case::plan::plan_problem(&c).map(|(problem, mut settings)| {
+        start_written = problem.start.shape.is_some();
         if let Some(t) = threads {
             settings.threads = Some(usize::from(t));
         }
@@ -231,9 +234,14 @@ pub(crate) fn run_plan(
                 equilibria_not_a_plan(&result),
                 if result.replay.start_held() {
                     TRY_DEPARTURE.to_string()
-                } else {
+                } else if start_written {
                     format!(
                         "the start shape is not held by its end pose (not a stable equilibrium there): the replay leaves it by {:.3} L at k = 0, so no path from it can be executed by the controlled end; start from the pose alone (plan.start without `shape`) or from a shape the pose holds",
+                        result.replay.start_deviation_over_l
+                    )
+                } else {
+                    format!(
+                        "the replay leaves the start shape solved for the start pose by {:.3} L at k = 0 (the solve's equilibrium is not one the replay's first solve stays on), so no path from it can be executed by the controlled end; give plan.start a starting `shape` near the equilibrium wanted, or move the start pose a little",
                         result.replay.start_deviation_over_l
                     )
                 }
