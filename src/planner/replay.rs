@@ -9,6 +9,7 @@
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
+use crate::optim::AlOptions;
 use crate::planner::path::DeformationPath;
 use crate::planner::workers::{JOB_EQUILIBRIA, Workers};
 use crate::rod::kinematics::Shape;
@@ -168,17 +169,40 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
 
 /// The static shape of `base` held at the end pose of coefficients `a` (with boundary
 /// `positions`), solved from `from`'s shape and multipliers; the problem is returned with it.
+/// With `stiff_retry` (the replay's steps), a solve that does not converge runs once more from
+/// the same start with a hundred times the starting penalty. The tracking rounds' marches do
+/// without: their equilibria are targets, and the optimiser's path follows them.
 fn solve_held(
     base: &StaticProblem,
     from: &StaticSolution,
     a: &[f64],
     positions: &[[f64; 3]],
     opts: &StaticOptions,
+    stiff_retry: bool,
 ) -> (StaticProblem, StaticSolution) {
     let mut p = EndPose::of(&base.model, a, positions).problem(base);
     let lambda = warm_multipliers(base, from, &p);
     let sol = solve_static_warm(&mut p, &from.a, &lambda, opts);
-    (p, sol)
+    if sol.status == SolveStatus::Converged || !stiff_retry {
+        return (p, sol);
+    }
+    // Where the rod is pressed hard (large contact and end forces), the Lagrangian curves down
+    // steeply across the constraints, and at the starting penalty the augmented function is
+    // not convex even next to the equilibrium it starts from: Newton's steps run off the
+    // branch. Once more with the penalty a hundred times higher.
+    let stiff = StaticOptions {
+        al: AlOptions {
+            rho_initial: (opts.al.rho_initial * 100.0).min(opts.al.rho_max),
+            ..opts.al
+        },
+        ..*opts
+    };
+    let again = solve_static_warm(&mut p, &from.a, &lambda, &stiff);
+    if again.status == SolveStatus::Converged {
+        (p, again)
+    } else {
+        (p, sol)
+    }
 }
 
 /// Total normal force (case units) the obstacles of `base` exert on a solution of a problem
@@ -230,7 +254,7 @@ pub fn replay(
         (a.clone(), shape.positions.clone(), u)
     };
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
-        let (mut p, mut sol) = solve_held(base, &from.sol, &target.0, &target.1, static_opts);
+        let (mut p, mut sol) = solve_held(base, &from.sol, &target.0, &target.1, static_opts, true);
         // A solve that ran out of iterations gets one more budget from where it stopped.
         if sol.status == SolveStatus::IterationLimit {
             sol = solve_static_warm(&mut p, &sol.a, &sol.lambda, static_opts);
@@ -471,7 +495,7 @@ fn march(
         path.shape_at(z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
         let from = out.last().map_or(first, |(_, sol)| sol);
-        let (_, sol) = solve_held(base, from, &a, &shape.positions, opts);
+        let (_, sol) = solve_held(base, from, &a, &shape.positions, opts, false);
         out.push((model.evaluate(&sol.a).positions, sol));
     }
     out

@@ -125,3 +125,74 @@ fn a_start_resting_on_an_obstacle_is_where_the_replay_starts() {
         rep.start_deviation_over_l
     );
 }
+
+/// A generated 3D problem in the paper's basis (the suite's generator, seed 8, its 3D problems
+/// only, `"discretisation": {"basis": "paper"}`: `spatial_13`) whose start pose presses the
+/// cable onto a capsule with 288 (units of Rf/L²), held by end forces of the same size. Started
+/// from that equilibrium with its multipliers at the penalty the static solves start with
+/// (1e3), the solve of a pose moved by k = 0.0005 along the straight path ran off it (measured:
+/// infeasible, violation 0.087, 5.0 away in the coefficients): the augmented function is not
+/// convex there at that penalty. The replay's steps try once more with a hundred times the
+/// penalty; its first step then converges to the equilibrium a solve started at that penalty
+/// finds, next to the start.
+#[test]
+fn a_replay_step_from_a_hard_pressed_start_stays_on_its_branch() {
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::endpoints::EndPose;
+    use dlo_planner::planner::replay::{EarlyStop, ReplayOptions, replay};
+    use dlo_planner::statics::{StaticOptions, solve_static_warm};
+    let text = r#"{"name": "spatial_8_13", "planar": false,
+      "rod": {"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.77, "radius": 0.01},
+      "discretisation": {"basis": "paper"},
+      "constraints": [{"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}],
+      "obstacles": [{"name": "o0", "shape": {"type": "cuboid", "half_extents": [0.0416809713178576, 0.051046019552126135, 0.07314177641244257]}, "position": [0.09273376101350067, -0.06541263473750056, 1.0803039840007889]},
+                    {"name": "o1", "shape": {"type": "capsule", "a": [0, -1, 0], "b": [0, 1, 0], "radius": 0.09822237499569735}, "rotation": [0, 0, 2.444272655591042], "position": [-0.11294322312193135, 0.023118939926305815, 0.7944184656228619]}],
+      "plan": {"start": {"position": [-0.3033130029835817, -0.006076439870102338, 0.7989195046552738], "tangent": [-0.783861882642939, -0.0157035456755636, 0.6207366169259574], "twist": -0.23543873561215822},
+               "goal": {"position": [0.34910751991515376, -0.11847457869833107, 0.6468145129440668], "tangent": [0.8058820018895145, -0.2734874650584217, 0.5251274183343191], "twist": 0.04092343004332555}}}"#;
+    let c = dlo_planner::case::parse(text, std::path::Path::new("spatial_8_13.json")).unwrap();
+    let p = Planner::from_case(&c).unwrap();
+    let start = &p.start;
+    let force: f64 = start.lambda.iter().fold(0.0, |m, l| m.max(*l));
+    assert!(force > 200.0, "{force}");
+    let path = p.path();
+    let z = vec![0.0; path.n_vars()];
+    let rep = replay(
+        &p.held,
+        start,
+        &path,
+        &z,
+        ReplayOptions {
+            early_stop: EarlyStop::Departure,
+            ..p.settings.replay()
+        },
+        &p.static_options,
+        &mut dlo_planner::planner::observer::Silent,
+        &std::sync::atomic::AtomicBool::new(false),
+    );
+    assert!(rep.steps.len() >= 2);
+    let first = &rep.steps[1];
+    assert!(first.converged, "{:?}", first.status);
+    // The reference: the same pose solved from the start at a penalty of 1e4 from the outset.
+    let mut a = vec![0.0; path.n()];
+    path.shape_at(&z, first.k, &mut a);
+    let shape = p.base.model.evaluate(&a);
+    let mut held = EndPose::of(&p.base.model, &a, &shape.positions).problem(&p.held);
+    let mut opts: StaticOptions = p.static_options;
+    opts.al.rho_initial = 1e4;
+    let reference = solve_static_warm(&mut held, &start.a, &start.lambda, &opts);
+    assert_eq!(reference.status, SolveStatus::Converged);
+    let d = first
+        .a
+        .iter()
+        .zip(&reference.a)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(d < 1e-6, "{d}");
+    let moved = first
+        .a
+        .iter()
+        .zip(&start.a)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 0.5, "{moved}");
+}
