@@ -299,7 +299,7 @@ fn end_shape(
             }
             (None, None) => problem.initial.clone(),
         };
-        let sol = solve_static(&mut pose.problem(base), &a0, opts);
+        let sol = solve_from(&pose.problem(base), &a0, opts);
         on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
     };
     if sol.status != SolveStatus::Converged {
@@ -328,6 +328,32 @@ fn end_shape(
         });
     }
     Ok((sol, contacts))
+}
+
+/// The static solve of `p` from `a0`, and where it does not converge, again from `a0` with ten
+/// and then a hundred times the starting penalty (the first that converges). From the natural
+/// state, a penalty too small for the obstacles lets the first inner solves pull the rod
+/// through one on its way to the pose, where it stays caught; a stiffer one keeps it outside
+/// from the start.
+fn solve_from(p: &StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticSolution {
+    let mut sol = solve_static(&mut p.clone(), a0, opts);
+    for factor in [10.0, 100.0] {
+        if sol.status == SolveStatus::Converged {
+            break;
+        }
+        let stiff = StaticOptions {
+            al: crate::optim::AlOptions {
+                rho_initial: (opts.al.rho_initial * factor).min(opts.al.rho_max),
+                ..opts.al
+            },
+            ..*opts
+        };
+        let again = solve_static(&mut p.clone(), a0, &stiff);
+        if again.status == SolveStatus::Converged {
+            sol = again;
+        }
+    }
+    sol
 }
 
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,

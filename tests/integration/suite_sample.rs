@@ -1,36 +1,38 @@
 //! A fixed sample of the generated suite's problems (`examples/plan_suite.rs`), planned with
-//! every setting at its default: the first problems of the planar and of the 3D generator, each
-//! started from seed 1, that have static start and goal shapes.
+//! every setting at its default: problems of the planar and of the 3D generator, each started
+//! from seed 1, named by their place in its sequence.
 
 use crate::suite::{Outcome, Rng, planar_problem, run, spatial_problem};
 
-/// The first `n` problems of `generate` (seed 1) with static start and goal shapes, planned.
-fn first(generate: fn(&mut Rng, usize) -> String, kind: &str, n: usize) -> Vec<Outcome> {
+/// Problems `indices` (increasing) of `generate` (seed 1), planned; each must have static start
+/// and goal shapes.
+fn sample(generate: fn(&mut Rng, usize) -> String, kind: &str, indices: &[usize]) -> Vec<Outcome> {
     let mut rng = Rng(1);
     let none = serde_json::json!({});
-    let mut out = Vec::new();
-    let mut i = 0;
-    while out.len() < n {
-        let text = generate(&mut rng, i);
-        if let Some(o) = run(&text, &format!("{kind}_{i}"), &none, &none) {
-            out.push(o);
-        }
-        i += 1;
-    }
-    out
+    let last = indices.iter().copied().max().unwrap_or(0);
+    (0..=last)
+        .map(|i| (i, generate(&mut rng, i)))
+        .filter(|(i, _)| indices.contains(i))
+        .map(|(i, text)| {
+            let name = format!("{kind}_{i}");
+            run(&text, &name, &none, &none).unwrap_or_else(|| panic!("{name}: no static ends"))
+        })
+        .collect()
 }
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
 /// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
-/// is called coinciding. The sample: the first three planar problems (`planar_0`, `planar_2`,
-/// `planar_3`) and the first 3D problem, which must keep coinciding with their replays
+/// is called coinciding. The sample: the planar problems `planar_0`, `planar_2` and `planar_3`
+/// (`planar_1`, whose start shape the first solve misses, has its own test below) and the
+/// first 3D problem, which must keep
+/// coinciding with their replays
 /// (measured 1.6 %, 1.5 %, 1.1 % and 0.7 % of L), and the second 3D problem with a static start
 /// and goal (`spatial_0`), whose straight-line path peaks at an end shape and coincides with its
 /// replay, so that it is the plan without optimising. (The suite's second 3D problem,
 /// `spatial_1`, is one of its failures, reported in `docs/results.md`.)
 #[test]
 fn a_sample_of_the_generated_suite_plans_with_the_defaults() {
-    let planar = first(planar_problem, "planar", 3);
+    let planar = sample(planar_problem, "planar", &[0, 2, 3]);
     let spatial = [0, 2].map(|i| {
         let (_, r) = suite_3d_plan(i);
         (i, r)
@@ -679,4 +681,30 @@ fn a_replay_ends_at_its_first_unconverged_solve() {
         );
     }
     assert!(!early.coincide && !early.all_converged);
+}
+
+/// The generator's second planar problem (seed 1, `planar_1`): its start pose has a static
+/// shape clear of the obstacles, which the solve from the natural state at the static solves'
+/// starting penalty (1e3) misses (measured: infeasible, 0.040 L inside obstacle `o0`; the run
+/// said no static shape reaches the pose). Solved again with ten times the penalty, it is
+/// found: converged, stable, and clear of every obstacle on the verification grid.
+#[test]
+fn a_start_the_first_solve_misses_is_found_with_a_stiffer_penalty() {
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::verify::{fine_model, shape_worst_clearance};
+    use dlo_planner::statics::SolveStatus;
+    let mut rng = Rng(1);
+    let _first = planar_problem(&mut rng, 0);
+    let text = planar_problem(&mut rng, 1);
+    let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_1.json")).unwrap();
+    let p = Planner::from_case(&c).expect("the start pose has a static shape");
+    assert_eq!(p.start.status, SolveStatus::Converged);
+    assert_eq!(p.start.stable, Some(true));
+    assert!(p.start.max_violation <= 1e-9);
+    let fine = fine_model(&p.base.model, p.settings.verify_s_samples, 4);
+    let worst = shape_worst_clearance(&fine, &c.obstacles, &p.start.a).expect("obstacles");
+    assert!(
+        worst.clearance >= -1e-6 * c.problem.model.rod.length,
+        "{worst:?}"
+    );
 }
