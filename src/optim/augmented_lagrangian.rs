@@ -531,19 +531,9 @@ const NEAR_EQUILIBRIUM: f64 = 1e-2;
 /// for another branch; with them, Newton's first step stays (or stays near). `None` elsewhere:
 /// a start far from equilibrium keeps zero multipliers.
 fn equilibrium_multipliers<P: Nlp>(p: &mut P, x: &[f64], opts: &AlOptions) -> Option<Vec<f64>> {
-    let m = p.m();
-    if m == 0 {
-        return None;
-    }
-    let mut c = vec![0.0; m];
-    p.values(x, &mut c);
-    if violation(p, &c) > opts.feasibility_tol {
-        return None;
-    }
-    let mut g = vec![0.0; p.n()];
-    p.gradient(x, &vec![0.0; m], &mut g);
-    let scale = inf_norm(&g).max(1.0);
-    let (lam, residual) = least_squares_multipliers_at(p, x, &c, &vec![0.0; m], opts.active_tol)?;
+    let (c, scale) = feasible_with_scale(p, x, opts)?;
+    let zero = vec![0.0; c.len()];
+    let (lam, residual) = least_squares_multipliers_at(p, x, &c, &zero, opts.active_tol)?;
     if residual > NEAR_EQUILIBRIUM * scale {
         return None;
     }
@@ -560,20 +550,32 @@ fn equilibrium_multipliers<P: Nlp>(p: &mut P, x: &[f64], opts: &AlOptions) -> Op
 /// max(1, ‖∇f‖∞)`, and not curving down along the constraints. A warm start from a converged
 /// solve of the same problem (a replay's first step, on the start shape) is one.
 fn on_stable_equilibrium<P: Nlp>(p: &mut P, x: &[f64], lambda: &[f64], opts: &AlOptions) -> bool {
-    let m = p.m();
-    if m == 0 || lambda.len() != m {
+    if lambda.len() != p.m() {
         return false;
+    }
+    let Some((_, scale)) = feasible_with_scale(p, x, opts) else {
+        return false;
+    };
+    let mut g = vec![0.0; p.n()];
+    p.gradient(x, lambda, &mut g);
+    inf_norm(&g) <= NEAR_EQUILIBRIUM * scale && !unstable_along_constraints(p, x, lambda)
+}
+
+/// At a feasible `x` of a problem with constraints: the row values (the last [`Nlp::values`]
+/// call is at `x`) and `max(1, ‖∇f‖∞)`, the scale of a KKT residual there; `None` elsewhere.
+fn feasible_with_scale<P: Nlp>(p: &mut P, x: &[f64], opts: &AlOptions) -> Option<(Vec<f64>, f64)> {
+    let m = p.m();
+    if m == 0 {
+        return None;
     }
     let mut c = vec![0.0; m];
     p.values(x, &mut c);
     if violation(p, &c) > opts.feasibility_tol {
-        return false;
+        return None;
     }
     let mut g = vec![0.0; p.n()];
     p.gradient(x, &vec![0.0; m], &mut g);
-    let scale = inf_norm(&g).max(1.0);
-    p.gradient(x, lambda, &mut g);
-    inf_norm(&g) <= NEAR_EQUILIBRIUM * scale && !unstable_along_constraints(p, x, lambda)
+    Some((c, inf_norm(&g).max(1.0)))
 }
 
 /// The reduced Hessian's smallest eigenvalue over its largest magnitude (at least 1) at
@@ -803,10 +805,14 @@ mod tests {
         assert!((out.lambda[0] + 0.4).abs() < 1e-7 && (out.lambda[1] - 1.2).abs() < 1e-7);
     }
 
-    /// min x + 2y on the unit circle x² + y² = 1: x* = −(1, 2)/√5, λ* = √5/2; with the
-    /// exact Hessian, so the multiplier method runs Newton inner steps.
-    struct Circle;
-    impl Nlp for Circle {
+    /// min q x² + a x + b y on the unit circle x² + y² = 1, with the exact Hessian, so the
+    /// multiplier method runs Newton inner steps.
+    struct OnCircle {
+        q: f64,
+        a: f64,
+        b: f64,
+    }
+    impl Nlp for OnCircle {
         fn n(&self) -> usize {
             2
         }
@@ -818,11 +824,11 @@ mod tests {
         }
         fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
             c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
-            x[0] + 2.0 * x[1]
+            self.q * x[0] * x[0] + self.a * x[0] + self.b * x[1]
         }
         fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
-            g[0] = 1.0 + 2.0 * y[0] * x[0];
-            g[1] = 2.0 + 2.0 * y[0] * x[1];
+            g[0] = 2.0 * self.q * x[0] + self.a + 2.0 * y[0] * x[0];
+            g[1] = self.b + 2.0 * y[0] * x[1];
         }
         fn has_hessian(&self) -> bool {
             true
@@ -830,11 +836,20 @@ mod tests {
         fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
             let j = [2.0 * x[0], 2.0 * x[1]];
             for a in 0..2 {
-                h[3 * a] += 2.0 * y[0];
+                h[3 * a] += 2.0 * y[0] + if a == 0 { 2.0 * self.q } else { 0.0 };
                 for b in 0..2 {
                     h[2 * a + b] += s[0] * j[a] * j[b];
                 }
             }
+        }
+    }
+
+    /// min x + 2y on the unit circle: x* = −(1, 2)/√5, λ* = √5/2.
+    fn circle() -> OnCircle {
+        OnCircle {
+            q: 0.0,
+            a: 1.0,
+            b: 2.0,
         }
     }
 
@@ -849,7 +864,7 @@ mod tests {
                 newton_multipliers,
                 ..AlOptions::default()
             };
-            let out = augmented_lagrangian(&mut Circle, &mut x, None, opts);
+            let out = augmented_lagrangian(&mut circle(), &mut x, None, opts);
             assert_eq!(out.status, AlStatus::Converged);
             let r5 = 5.0_f64.sqrt();
             assert!(
@@ -1002,40 +1017,14 @@ mod tests {
         assert_eq!(oh.lambda, or.lambda);
     }
 
-    /// min −2x² + y + 0.3x on the unit circle: a stable minimum P near (0.96, −0.27) where the
+    /// min −2x² + 0.3x + y on the unit circle: a stable minimum P near (0.96, −0.27) where the
     /// Lagrangian curves down across the circle (−4 + 2λ < 0 along x), and a lower one Q near
-    /// (−0.97, −0.23); with the exact Hessian.
-    struct Bent;
-    impl Nlp for Bent {
-        fn n(&self) -> usize {
-            2
-        }
-        fn m(&self) -> usize {
-            1
-        }
-        fn sense(&self, _i: usize) -> Sense {
-            Sense::Equal
-        }
-        fn values(&mut self, x: &[f64], c: &mut [f64]) -> f64 {
-            c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
-            -2.0 * x[0] * x[0] + x[1] + 0.3 * x[0]
-        }
-        fn gradient(&mut self, x: &[f64], y: &[f64], g: &mut [f64]) {
-            g[0] = -4.0 * x[0] + 0.3 + 2.0 * y[0] * x[0];
-            g[1] = 1.0 + 2.0 * y[0] * x[1];
-        }
-        fn has_hessian(&self) -> bool {
-            true
-        }
-        fn hessian(&mut self, x: &[f64], y: &[f64], s: &[f64], h: &mut [f64]) {
-            let j = [2.0 * x[0], 2.0 * x[1]];
-            h[0] += -4.0 + 2.0 * y[0];
-            h[3] += 2.0 * y[0];
-            for a in 0..2 {
-                for b in 0..2 {
-                    h[2 * a + b] += s[0] * j[a] * j[b];
-                }
-            }
+    /// (−0.97, −0.23).
+    fn bent() -> OnCircle {
+        OnCircle {
+            q: -2.0,
+            a: 0.3,
+            b: 1.0,
         }
     }
 
@@ -1047,7 +1036,7 @@ mod tests {
     #[test]
     fn a_warm_start_on_a_stable_minimum_stays_there() {
         let mut x = vec![0.95, -0.3];
-        let out = augmented_lagrangian(&mut Bent, &mut x, None, AlOptions::default());
+        let out = augmented_lagrangian(&mut bent(), &mut x, None, AlOptions::default());
         assert_eq!(out.status, AlStatus::Converged);
         let t = x[1].atan2(x[0]);
         let dfdt = t.cos() * (4.0 * t.sin() + 1.0) - 0.3 * t.sin();
@@ -1066,13 +1055,13 @@ mod tests {
             ..AlOptions::default()
         };
         let mut y = x.clone();
-        let again = augmented_lagrangian(&mut Bent, &mut y, Some(&lambda), opts);
+        let again = augmented_lagrangian(&mut bent(), &mut y, Some(&lambda), opts);
         assert_eq!(again.status, AlStatus::Converged);
         assert_eq!(y, x);
         // From the same point without the multiplier the run starts off equilibrium and
         // leaves P for the lower minimum Q.
         let mut z = x.clone();
-        let off = augmented_lagrangian(&mut Bent, &mut z, Some(&[0.0]), opts);
+        let off = augmented_lagrangian(&mut bent(), &mut z, Some(&[0.0]), opts);
         assert!(z[0] < -0.9, "{z:?} {off:?}");
     }
 }
