@@ -299,7 +299,7 @@ fn end_shape(
             }
             (None, None) => problem.initial.clone(),
         };
-        let sol = solve_from(&pose.problem(base), &a0, opts);
+        let sol = solve_from(pose.problem(base), &a0, opts);
         on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
     };
     if sol.status != SolveStatus::Converged {
@@ -335,8 +335,8 @@ fn end_shape(
 /// state, a penalty too small for the obstacles lets the first inner solves pull the rod
 /// through one on its way to the pose, where it stays caught; a stiffer one keeps it outside
 /// from the start.
-fn solve_from(p: &StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticSolution {
-    let mut sol = solve_static(&mut p.clone(), a0, opts);
+fn solve_from(mut p: StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticSolution {
+    let mut sol = solve_static(&mut p, a0, opts);
     for factor in [10.0, 100.0] {
         if sol.status == SolveStatus::Converged {
             break;
@@ -348,7 +348,7 @@ fn solve_from(p: &StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticSolu
             },
             ..*opts
         };
-        let again = solve_static(&mut p.clone(), a0, &stiff);
+        let again = solve_static(&mut p, a0, &stiff);
         if again.status == SolveStatus::Converged {
             sol = again;
         }
