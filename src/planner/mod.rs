@@ -317,8 +317,15 @@ fn end_shape(
                 .map_or(String::new(), |(label, w)| {
                     format!("; the most violated constraint is {label} (by {w:.3e} L)")
                 });
+            let from = if end.shape.is_some() {
+                "the end's `shape`"
+            } else if seed.is_some() {
+                "a shape bent from the held end's frame towards the pose's"
+            } else {
+                "the natural state"
+            };
             format!(
-                "no static shape reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L){blocking}",
+                "the static solve found no shape that reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L){blocking}; it searches from {from}, at three starting penalties: a shape that goes round the obstacles another way may still exist, and a `shape` near it given to this end would start the solve there",
                 sol.status, sol.max_violation
             )
         };

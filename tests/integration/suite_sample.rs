@@ -708,3 +708,22 @@ fn a_start_the_first_solve_misses_is_found_with_a_stiffer_penalty() {
         "{worst:?}"
     );
 }
+
+/// The generator's `planar_33` (seed 1): no static solve of its goal pose converges (the box
+/// beside the goal stands between it and the natural state). The refusal says what was
+/// searched and how to search elsewhere, not only that no shape exists: the solve is local.
+#[test]
+fn a_refused_pose_says_where_the_solve_searched() {
+    use dlo_planner::planner::Planner;
+    let mut rng = Rng(1);
+    let text = (0..=33)
+        .map(|i| planar_problem(&mut rng, i))
+        .last()
+        .unwrap();
+    let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_33.json")).unwrap();
+    let err = Planner::from_case(&c).expect_err("refused").to_string();
+    assert!(err.contains("plan.goal"), "{err}");
+    assert!(err.contains("searches from the natural state"), "{err}");
+    assert!(err.contains("three starting penalties"), "{err}");
+    assert!(err.contains("a `shape` near it given to this end"), "{err}");
+}
