@@ -348,14 +348,7 @@ fn solve_from(mut p: StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticS
         if sol.status == SolveStatus::Converged {
             break;
         }
-        let stiff = StaticOptions {
-            al: crate::optim::AlOptions {
-                rho_initial: (opts.al.rho_initial * factor).min(opts.al.rho_max),
-                ..opts.al
-            },
-            ..*opts
-        };
-        let again = solve_static(&mut p, a0, &stiff);
+        let again = solve_static(&mut p, a0, &opts.stiffer(factor));
         if again.status == SolveStatus::Converged {
             sol = again;
         }

@@ -9,7 +9,6 @@
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
-use crate::optim::AlOptions;
 use crate::planner::path::DeformationPath;
 use crate::planner::workers::{JOB_EQUILIBRIA, Workers};
 use crate::rod::kinematics::Shape;
@@ -190,14 +189,7 @@ fn solve_held(
     // steeply across the constraints, and at the starting penalty the augmented function is
     // not convex even next to the equilibrium it starts from: Newton's steps run off the
     // branch. Once more with the penalty a hundred times higher.
-    let stiff = StaticOptions {
-        al: AlOptions {
-            rho_initial: (opts.al.rho_initial * 100.0).min(opts.al.rho_max),
-            ..opts.al
-        },
-        ..*opts
-    };
-    let again = solve_static_warm(&mut p, &from.a, &lambda, &stiff);
+    let again = solve_static_warm(&mut p, &from.a, &lambda, &opts.stiffer(100.0));
     if again.status == SolveStatus::Converged {
         (p, again)
     } else {

@@ -32,6 +32,20 @@ impl Default for StaticOptions {
     }
 }
 
+impl StaticOptions {
+    /// These options with the starting penalty `factor` times higher (at most the cap): a
+    /// solve that did not converge from the usual penalty tries again with it.
+    pub fn stiffer(&self, factor: f64) -> StaticOptions {
+        StaticOptions {
+            al: AlOptions {
+                rho_initial: (self.al.rho_initial * factor).min(self.al.rho_max),
+                ..self.al
+            },
+            ..*self
+        }
+    }
+}
+
 /// A solved static shape.
 #[derive(Clone, Debug)]
 pub struct StaticSolution {
