@@ -192,7 +192,7 @@ pub fn add_weighted_curvature(
     adj.clear();
     for (b, blk) in blocks.iter().enumerate() {
         let w = &y[offsets[b]..offsets[b + 1]];
-        if w.iter().any(|v| *v != 0.0) {
+        if !crate::kernels::all_zero(w) {
             blk.add_gradient(model, a, shape, w, adj);
             blk.add_curvature(model, a, shape, w, h);
         }

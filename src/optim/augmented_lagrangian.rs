@@ -160,7 +160,8 @@ crate::kernels::wide::dispatch! {
     /// The augmented function `Φ` from `f` and the row values `c`; writes the multiplier
     /// estimates `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows
     /// whose penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton
-    /// part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`.
+    /// part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`. The rows' `senses` are empty when every row is an
+    /// inequality.
     fn augment(
         f: f64,
         c: &[f64],
@@ -183,6 +184,9 @@ fn augment_body(
     y: &mut [f64],
     s: &mut [f64],
 ) -> f64 {
+    if senses.is_empty() {
+        return augment_inequalities(f, c, lam, rho, y, s);
+    }
     let mut phi = f;
     for i in 0..c.len() {
         match senses[i] {
@@ -192,21 +196,68 @@ fn augment_body(
                 s[i] = rho;
             }
             Sense::LessEq => {
-                let t = (lam[i] + rho * c[i]).max(0.0);
+                let v = lam[i] + rho * c[i];
+                let t = v.max(0.0);
                 phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
                 y[i] = t;
-                // The penalty's curvature also counts for a row that sits on its boundary to
-                // within rounding (`λ + ρc` in (−ρ·1e-9, 0]): there `Φ` has a kink in its
-                // second derivative, and a Hessian without the row lets a Newton step cross the
-                // boundary by far more than the quadratic penalty allows (the line search then
-                // fails at a contact the start shape already touches).
-                s[i] = if lam[i] + rho * c[i] > -rho * BOUNDARY_BAND {
-                    rho
-                } else {
-                    0.0
-                };
+                s[i] = less_eq_weight(v, rho);
             }
         }
+    }
+    phi
+}
+
+/// The penalty weight of an inequality row with `λ + ρc = v`. The penalty's curvature also
+/// counts for a row that sits on its boundary to within rounding (`v` in (−ρ·1e-9, 0]): there
+/// `Φ` has a kink in its second derivative, and a Hessian without the row lets a Newton step
+/// cross the boundary by far more than the quadratic penalty allows (the line search then fails
+/// at a contact the start shape already touches).
+#[inline(always)]
+fn less_eq_weight(v: f64, rho: f64) -> f64 {
+    if v > -rho * BOUNDARY_BAND { rho } else { 0.0 }
+}
+
+/// [`augment_body`] for inequality rows only, in two passes: the multiplier estimates and
+/// weights row by row (vectorised), then `Φ`'s sum in row order over the rows that add to it.
+/// A row with `λ = 0` whose penalty is inactive adds exactly +0, which leaves the sum as it is
+/// (most rows are such): the result is the same bit for bit as adding every row.
+#[inline(always)]
+fn augment_inequalities(
+    f: f64,
+    c: &[f64],
+    lam: &[f64],
+    rho: f64,
+    y: &mut [f64],
+    s: &mut [f64],
+) -> f64 {
+    let m = c.len();
+    let (c, lam, y, s) = (&c[..m], &lam[..m], &mut y[..m], &mut s[..m]);
+    for i in 0..m {
+        let v = lam[i] + rho * c[i];
+        y[i] = v.max(0.0);
+        s[i] = less_eq_weight(v, rho);
+    }
+    let mut phi = f;
+    const BLOCK: usize = 8;
+    let (y, lam) = (&y[..m], &lam[..m]);
+    for (yb, lb) in y.chunks(BLOCK).zip(lam.chunks(BLOCK)) {
+        // Whether every `y` and `λ` of the block is ±0 (the sign bit shifted out).
+        let any = yb
+            .iter()
+            .zip(lb)
+            .fold(0u64, |acc, (t, l)| acc | ((t.to_bits() | l.to_bits()) << 1));
+        if any == 0 {
+            continue;
+        }
+        for (&t, &l) in yb.iter().zip(lb) {
+            if t != 0.0 || l != 0.0 {
+                phi += (t * t - l * l) / (2.0 * rho);
+            }
+        }
+    }
+    // Adding +0 turns −0 into +0: the same sum as with every row added.
+    if phi == 0.0 && m > 0 {
+        phi = 0.0;
     }
     phi
 }
@@ -303,6 +354,12 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
     let mut penalty_held = false;
     let mut outer = 0;
     let senses: Vec<Sense> = (0..m).map(|i| p.sense(i)).collect();
+    // For `augment`: empty when every row is an inequality.
+    let row_senses: &[Sense] = if senses.iter().all(|&s| s == Sense::LessEq) {
+        &[]
+    } else {
+        &senses
+    };
     let mut inner_tol = 1e-3_f64.max(opts.optimality_tol);
     let mut sw = vec![0.0; m];
     // Second-order multiplier steps until one outer iteration fails to cut the violation enough
@@ -319,7 +376,7 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
         p.set_multipliers(&lambda);
         let out = if use_newton {
             let lam = &lambda;
-            let senses = &senses;
+            let senses = row_senses;
             // `eval` and `hess` share the problem and the buffers; they run one after the other,
             // and `hess` comes right after an `eval` at its point (the problem's state, `y` and
             // the penalty weights are that evaluation's).
@@ -368,7 +425,7 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
             let y = &mut y;
             let sw = &mut sw;
             let p = &mut *p;
-            let senses = &senses;
+            let senses = row_senses;
             let last = &mut last;
             bfgs(
                 |xv, g| {
@@ -405,7 +462,7 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
         }
         let f_now = last.at(p, x, &mut c);
         let dual_step = if dual_ok && m > 0 {
-            augment(f_now, &c, &lambda, rho, &senses, &mut y, &mut sw);
+            augment(f_now, &c, &lambda, rho, row_senses, &mut y, &mut sw);
             // Newton's Hessian at x used these multipliers and this penalty: it is ∇²Φ here.
             if last_hessian.0.as_slice() != &x[..] {
                 last_hessian.1 = vec![0.0; n * n];

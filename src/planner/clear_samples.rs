@@ -70,7 +70,7 @@ impl ClearSamples {
         for (i, f) in self.free.iter_mut().enumerate() {
             *f = lambda
                 .get(i * per..(i + 1) * per)
-                .is_some_and(|l| l.iter().all(|&v| v == 0.0));
+                .is_some_and(crate::kernels::all_zero);
         }
     }
 

@@ -13,6 +13,7 @@
 //! (`Rf/L`), positions in units of `L`.
 
 use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
+use crate::kernels::all_zero;
 use crate::optim::{Nlp, Sense};
 use crate::planner::clear_samples::ClearSamples;
 use crate::planner::path::DeformationPath;
@@ -79,6 +80,8 @@ struct SampleWork {
     rows: Vec<f64>,
     /// The sample's share of the objective's gradient, in the shape's coefficients.
     ga: Vec<f64>,
+    /// Its projections on the path's admissible directions ([`DeformationPath::project`]).
+    proj: Vec<f64>,
     /// The z-gradient of its energy (Hessian only).
     gz: Vec<f64>,
     /// The sample's share of the Hessian in the shape's coefficients (row-major `n×n`).
@@ -88,6 +91,8 @@ struct SampleWork {
     /// Whether its rows at the last evaluation are its last recorded ones (its shape evaluated
     /// all the same; see [`MinimaxProblem::set_skip_clear_samples`]).
     rows_kept: bool,
+    /// Whether its shape was left out at the last evaluation (the same).
+    left_out: bool,
     adj: Adjoint,
 }
 
@@ -125,10 +130,12 @@ impl MinimaxProblem {
                 gu: vec![0.0; n],
                 rows: vec![0.0; per],
                 ga: vec![0.0; n],
+                proj: vec![0.0; path.basis.len()],
                 gz: Vec::new(),
                 ha: Vec::new(),
                 y: vec![0.0; per],
                 rows_kept: false,
+                left_out: false,
                 adj: Adjoint::new(&model),
             })
             .collect();
@@ -412,39 +419,23 @@ impl Nlp for MinimaxProblem {
             && self.travel_weight == 0.0
             && self.skip.as_ref().is_some_and(|sk| sk.shapes_optional);
         let rows_only = !light && self.swept.is_none() && self.skip.is_some();
-        // Which shapes stay left out (for which the samples' coefficients are needed first),
-        // then, sample by sample, the coefficients (unless done here), shapes, energies and
-        // rows.
-        let mut i = 0;
-        for (j, &k) in self.ks.iter().enumerate() {
-            if light {
-                self.path.shape_at(z, k, &mut self.a[j]);
-            }
-            let interior = k > 0.0 && k < 1.0;
-            let keep = match &self.skip {
-                Some(sk) if light => !interior || sk.clear(i, j, &self.a[j]),
-                _ => false,
-            };
-            if let Some(sk) = &mut self.skip {
-                sk.stale[j] = keep;
-                sk.left_out += keep as usize;
-            }
-            i += interior as usize;
-        }
-        let left_out =
-            |skip: &Option<ClearSamples>, j: usize| skip.as_ref().is_some_and(|sk| sk.stale[j]);
+        // Sample by sample: the coefficients, whether the shape stays left out, the shape, the
+        // energy and the rows.
         {
             let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
             let (path, ks, skip, objective) = (&self.path, &self.ks, &self.skip, self.objective);
             let (a, shapes, work) = (&mut self.a, &mut self.shapes, &mut self.work);
             self.workers
                 .for_each_chunk3(JOB_VALUES, a, shapes, work, |j0, a, shapes, work| {
-                    if !light {
-                        for (i, ai) in a.iter_mut().enumerate() {
-                            path.shape_at(z, ks[j0 + i], ai);
-                        }
+                    for ((i, ai), w) in a.iter_mut().enumerate().zip(work.iter_mut()) {
+                        path.shape_at(z, ks[j0 + i], ai);
+                        w.left_out = match (skip, w.interior) {
+                            (Some(sk), Some(ii)) if light => sk.clear(ii, j0 + i, ai),
+                            (Some(_), None) => light,
+                            _ => false,
+                        };
                     }
-                    model.evaluate_many(a, shapes, |i| !left_out(skip, j0 + i));
+                    model.evaluate_many(a, shapes, |i| !work[i].left_out);
                     for (i, (shape, w)) in shapes.iter().zip(work.iter_mut()).enumerate() {
                         w.gu.iter_mut().for_each(|g| *g = 0.0);
                         let t = model.energy(&a[i], shape, objective, Some(&mut w.gu));
@@ -453,7 +444,7 @@ impl Nlp for MinimaxProblem {
                             (Some(sk), Some(ii)) if rows_only => sk.clear(ii, j0 + i, &a[i]),
                             _ => false,
                         };
-                        if w.interior.is_some() && !w.rows_kept && !left_out(skip, j0 + i) {
+                        if w.interior.is_some() && !w.rows_kept && !w.left_out {
                             for (b, blk) in blocks.iter().enumerate() {
                                 let rows = &mut w.rows[offsets[b]..offsets[b + 1]];
                                 blk.values(model, &a[i], shape, rows);
@@ -464,6 +455,10 @@ impl Nlp for MinimaxProblem {
         }
         for (j, w) in self.work.iter().enumerate() {
             self.u[j] = w.u;
+            if let Some(sk) = &mut self.skip {
+                sk.stale[j] = w.left_out;
+                sk.left_out += w.left_out as usize;
+            }
             if w.interior.is_some() {
                 let rows = &mut c[row..row + per];
                 match &mut self.skip {
@@ -497,7 +492,7 @@ impl Nlp for MinimaxProblem {
         // A left-out shape is needed only where some of its rows have a weight.
         if self.skip.is_some() {
             for i in 0..self.interior.len() {
-                if y[i * per..(i + 1) * per].iter().any(|v| *v != 0.0) {
+                if !all_zero(&y[i * per..(i + 1) * per]) {
                     self.ensure_shape(self.interior[i]);
                 }
             }
@@ -512,6 +507,7 @@ impl Nlp for MinimaxProblem {
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
         let travel = travel_weight != 0.0;
+        let path = &self.path;
         self.workers
             .for_each_chunk(JOB_GRADIENT, &mut self.work, |j0, work| {
                 for (i, w) in work.iter_mut().enumerate() {
@@ -529,10 +525,10 @@ impl Nlp for MinimaxProblem {
                         sw.add_chord_cotangents(ii, ys, &interior_shapes, &mut w.adj);
                         sw.add_sample_weights(ii, ys, offsets, &mut w.y)
                     });
-                    if tracked || travel || swept_any || w.y.iter().any(|v| *v != 0.0) {
+                    if tracked || travel || swept_any || !all_zero(&w.y) {
                         for (b, blk) in blocks.iter().enumerate() {
                             let wb = &w.y[offsets[b]..offsets[b + 1]];
-                            if wb.iter().any(|v| *v != 0.0) {
+                            if !all_zero(wb) {
                                 blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
                             }
                         }
@@ -541,11 +537,12 @@ impl Nlp for MinimaxProblem {
                         add_track_travel(&mut w.adj, shapes, ks, j, target, weights);
                         w.adj.finish(model, &shapes[j], &mut w.ga);
                     }
+                    path.project(&w.ga, &mut w.proj);
                 }
             });
         for (w, &k) in self.work.iter().zip(&self.ks) {
             if w.interior.is_some() {
-                self.path.add_chain(&w.ga, k, g);
+                self.path.add_projected(&w.proj, k, g);
             }
         }
     }

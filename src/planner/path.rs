@@ -133,9 +133,23 @@ impl DeformationPath {
             heap.resize(r, 0.0);
             &mut heap
         };
+        self.project(grad_a, proj);
+        self.add_projected(proj, k, grad_z);
+    }
+
+    /// The projections `Nᵀ grad_a` of a gradient in coefficient space on the admissible
+    /// directions (`r` numbers): the first half of [`DeformationPath::add_chain`], which may run
+    /// on another thread than the second.
+    pub fn project(&self, grad_a: &[f64], proj: &mut [f64]) {
         for (p, col) in proj.iter_mut().zip(&self.basis) {
             *p = crate::rod::basis::dot(col, grad_a);
         }
+    }
+
+    /// Adds the chain rule at `k` for projections `proj` ([`DeformationPath::project`]) to
+    /// `grad_z`.
+    pub fn add_projected(&self, proj: &[f64], k: f64, grad_z: &mut [f64]) {
+        let r = self.basis.len();
         for i in 0..self.terms {
             let w = Self::weight(i + 1, k);
             for q in 0..r {

@@ -136,7 +136,7 @@ impl Nlp for StaticProblem {
         self.adj.clear();
         for (k, con) in self.constraints.iter().enumerate() {
             let w = &y[self.offsets[k]..self.offsets[k + 1]];
-            if w.iter().any(|v| *v != 0.0) {
+            if !crate::kernels::all_zero(w) {
                 con.add_gradient(&self.model, x, &self.shape, w, &mut self.adj);
             }
         }
