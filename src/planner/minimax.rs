@@ -86,6 +86,12 @@ struct SampleWork {
     gz: Vec<f64>,
     /// The sample's share of the Hessian in the shape's coefficients (row-major `n×n`).
     ha: Vec<f64>,
+    /// Its projection on the path's admissible directions (Hessian only, row-major `r×r`,
+    /// [`DeformationPath::project_hessian`]).
+    hm: Vec<f64>,
+    /// The z-Jacobian of the controlled end's position, row by row (Hessian with the travel
+    /// term only).
+    end_jac: [Vec<f64>; 3],
     /// The rows' weights (scratch).
     y: Vec<f64>,
     /// Whether its rows at the last evaluation are its last recorded ones (its shape evaluated
@@ -133,6 +139,8 @@ impl MinimaxProblem {
                 proj: vec![0.0; path.basis.len()],
                 gz: Vec::new(),
                 ha: Vec::new(),
+                hm: Vec::new(),
+                end_jac: Default::default(),
                 y: vec![0.0; per],
                 rows_kept: false,
                 left_out: false,
@@ -572,6 +580,8 @@ impl Nlp for MinimaxProblem {
         let (swept, targets, objective) = (&self.swept, &self.targets, self.objective);
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
+        let r = path.basis.len();
+        let end = model.mesh.boundaries.len() - 1;
         self.workers
             .for_each_chunk(JOB_HESSIAN, &mut self.work, |j0, work| {
                 for (i, w) in work.iter_mut().enumerate() {
@@ -607,6 +617,16 @@ impl Nlp for MinimaxProblem {
                     w.adj.finish_hessian(model, shape, ha);
                     let sj = &s[row..row + per];
                     add_penalty_gauss_newton(blocks, offsets, model, aj, shape, sj, &mut w.adj, ha);
+                    w.hm.resize(r * r, 0.0);
+                    path.project_hessian(&w.ha, &mut w.hm);
+                    if travel_weight != 0.0 {
+                        let rows = model.position_jacobian(shape, end);
+                        for (out, r) in w.end_jac.iter_mut().zip(&rows) {
+                            out.clear();
+                            out.resize(nv, 0.0);
+                            path.add_chain(r, k, out);
+                        }
+                    }
                 }
             });
         for (j, w) in self.work.iter().enumerate() {
@@ -614,7 +634,7 @@ impl Nlp for MinimaxProblem {
                 for (b, v) in gbar.iter_mut().zip(&w.gz) {
                     *b += self.weights[j] * v;
                 }
-                self.path.add_chain_hessian(&w.ha, self.ks[j], 1.0, h);
+                self.path.add_projected_hessian(&w.hm, self.ks[j], 1.0, h);
             }
         }
         if let Some(sw) = &self.swept {
@@ -634,29 +654,20 @@ impl Nlp for MinimaxProblem {
         }
         // The travel term's Gauss–Newton part: for each interval, `w/Δk DᵀD` with `D` the
         // z-Jacobian of `x(kⱼ₊₁) − x(kⱼ)` (the path's ends are fixed and contribute none).
+        // (The z-Jacobians of the end's position at the interior samples, from the chunks.)
         if self.travel_weight != 0.0 {
-            let end = self.model.mesh.boundaries.len() - 1;
-            let jac: Vec<Option<[Vec<f64>; 3]>> = (0..self.ks.len())
-                .map(|j| {
-                    let k = self.ks[j];
-                    (k > 0.0 && k < 1.0).then(|| {
-                        let rows = self.model.position_jacobian(&self.shapes[j], end);
-                        rows.map(|r| {
-                            let mut out = vec![0.0; nv];
-                            self.path.add_chain(&r, k, &mut out);
-                            out
-                        })
-                    })
-                })
-                .collect();
+            let jac = |j: usize| {
+                let w = &self.work[j];
+                w.interior.is_some().then_some(&w.end_jac)
+            };
             for j in 0..self.ks.len().saturating_sub(1) {
                 let w = self.travel_weight / (self.ks[j + 1] - self.ks[j]);
                 for c in 0..3 {
                     let mut d = vec![0.0; nv];
-                    if let Some(r) = &jac[j + 1] {
+                    if let Some(r) = jac(j + 1) {
                         d.iter_mut().zip(&r[c]).for_each(|(v, x)| *v += x);
                     }
-                    if let Some(r) = &jac[j] {
+                    if let Some(r) = jac(j) {
                         d.iter_mut().zip(&r[c]).for_each(|(v, x)| *v -= x);
                     }
                     add_rank_one(h, w, &d);

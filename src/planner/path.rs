@@ -161,22 +161,36 @@ impl DeformationPath {
     /// Adds `scale · ∂a/∂zᵀ · H · ∂a/∂z` at `k` to `h_z` (row-major `n_vars²`), for a row-major
     /// `n×n` matrix `h_a` in coefficient space.
     pub fn add_chain_hessian(&self, h_a: &[f64], k: f64, scale: f64, h_z: &mut [f64]) {
+        let r = self.basis.len();
+        let mut m = vec![0.0; r * r];
+        self.project_hessian(h_a, &mut m);
+        self.add_projected_hessian(&m, k, scale, h_z);
+    }
+
+    /// The projection `M = Nᵀ H N` (row-major `r×r`) of a row-major `n×n` matrix `h_a` in
+    /// coefficient space on the admissible directions: the first half of
+    /// [`DeformationPath::add_chain_hessian`], which may run on another thread than the second.
+    pub fn project_hessian(&self, h_a: &[f64], m: &mut [f64]) {
         let n = self.n();
         let r = self.basis.len();
-        let nv = self.n_vars();
-        // M = Nᵀ H N.
         let mut hn = vec![0.0; n * r];
         for (q, col) in self.basis.iter().enumerate() {
             for a in 0..n {
                 hn[a * r + q] = crate::rod::basis::dot(&h_a[a * n..(a + 1) * n], col);
             }
         }
-        let mut m = vec![0.0; r * r];
         for (p, col) in self.basis.iter().enumerate() {
             for q in 0..r {
                 m[p * r + q] = (0..n).map(|a| col[a] * hn[a * r + q]).sum();
             }
         }
+    }
+
+    /// Adds the chain rule at `k` for a projected matrix `m` ([`DeformationPath::project_hessian`]),
+    /// times `scale`, to `h_z`.
+    pub fn add_projected_hessian(&self, m: &[f64], k: f64, scale: f64, h_z: &mut [f64]) {
+        let r = self.basis.len();
+        let nv = self.n_vars();
         for i in 0..self.terms {
             let wi = scale * Self::weight(i + 1, k);
             for i2 in 0..self.terms {
