@@ -161,7 +161,7 @@ crate::kernels::wide::dispatch! {
     /// estimates `y` (the weights of `∇Φ = ∇f + Σ yᵢ∇cᵢ`) and the penalty weights `s` of the rows
     /// whose penalty is active or on its boundary (`ρ`, else 0), which make the Gauss–Newton
     /// part `Σ sᵢ∇cᵢ∇cᵢᵀ` of `∇²Φ`. The rows' `senses` are empty when every row is an
-    /// inequality.
+    /// inequality; `s` is empty when the weights are not wanted (BFGS's runs).
     fn augment(
         f: f64,
         c: &[f64],
@@ -193,14 +193,18 @@ fn augment_body(
             Sense::Equal => {
                 phi += lam[i] * c[i] + 0.5 * rho * c[i] * c[i];
                 y[i] = lam[i] + rho * c[i];
-                s[i] = rho;
+                if let Some(si) = s.get_mut(i) {
+                    *si = rho;
+                }
             }
             Sense::LessEq => {
                 let v = lam[i] + rho * c[i];
                 let t = v.max(0.0);
                 phi += (t * t - lam[i] * lam[i]) / (2.0 * rho);
                 y[i] = t;
-                s[i] = less_eq_weight(v, rho);
+                if let Some(si) = s.get_mut(i) {
+                    *si = less_eq_weight(v, rho);
+                }
             }
         }
     }
@@ -231,11 +235,18 @@ fn augment_inequalities(
     s: &mut [f64],
 ) -> f64 {
     let m = c.len();
-    let (c, lam, y, s) = (&c[..m], &lam[..m], &mut y[..m], &mut s[..m]);
-    for i in 0..m {
-        let v = lam[i] + rho * c[i];
-        y[i] = v.max(0.0);
-        s[i] = less_eq_weight(v, rho);
+    let (c, lam, y) = (&c[..m], &lam[..m], &mut y[..m]);
+    if s.is_empty() {
+        for i in 0..m {
+            y[i] = (lam[i] + rho * c[i]).max(0.0);
+        }
+    } else {
+        let s = &mut s[..m];
+        for i in 0..m {
+            let v = lam[i] + rho * c[i];
+            y[i] = v.max(0.0);
+            s[i] = less_eq_weight(v, rho);
+        }
     }
     let mut phi = f;
     const BLOCK: usize = 8;
@@ -423,14 +434,14 @@ pub fn augmented_lagrangian_warm<P: Nlp>(
             let lam = &lambda;
             let c = &mut c;
             let y = &mut y;
-            let sw = &mut sw;
             let p = &mut *p;
             let senses = row_senses;
             let last = &mut last;
             bfgs(
                 |xv, g| {
                     let f = last.at(p, xv, c);
-                    let phi = augment(f, c, lam, rho, senses, y, sw);
+                    // BFGS needs no penalty weights.
+                    let phi = augment(f, c, lam, rho, senses, y, &mut []);
                     p.gradient(xv, y, g);
                     phi
                 },

@@ -10,7 +10,9 @@
 /// value below it.
 const CLEAR_MARGIN: f64 = 1e-6;
 
-/// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's rows (and shape). On a
+/// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's rows (and shape); each
+/// sample keeps its own last rows ([`LastRows`]), so that the thread evaluating it records and
+/// tests them. On a
 /// rod whose positions depend on θ alone (planar, inextensible, fixed base), with obstacle rows
 /// only, a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
 /// which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|` ([`crate::rod::model::Model::position_bound_weights`]).
@@ -22,8 +24,6 @@ const CLEAR_MARGIN: f64 = 1e-6;
 pub(super) struct ClearSamples {
     /// `ωᵢ`.
     omega: Vec<f64>,
-    /// Per sample: its rows at its last evaluated shape.
-    last: Vec<Option<LastRows>>,
     /// Per interior sample: whether all its rows' multipliers are zero.
     free: Vec<bool>,
     /// Per sample: whether its shape is older than its coefficients.
@@ -39,7 +39,7 @@ pub(super) struct ClearSamples {
 
 /// A sample's rows at the coefficients of its last evaluated shape.
 #[derive(Clone, Debug)]
-struct LastRows {
+pub(super) struct LastRows {
     a: Vec<f64>,
     rows: Vec<f64>,
     /// The largest row.
@@ -56,7 +56,6 @@ impl ClearSamples {
     ) -> Self {
         ClearSamples {
             omega,
-            last: vec![None; samples],
             free: vec![false; interior],
             stale: vec![false; samples],
             left_out: 0,
@@ -74,10 +73,30 @@ impl ClearSamples {
         }
     }
 
-    /// Records sample `j`'s rows at coefficients `a` (its shape just evaluated).
-    pub(super) fn record(&mut self, j: usize, a: &[f64], rows: &[f64]) {
+    /// Whether interior sample `i`, whose last recorded rows are `last`, may keep them at
+    /// coefficients `a`.
+    pub(super) fn clear(&self, i: usize, last: Option<&LastRows>, a: &[f64]) -> bool {
+        if !self.free[i] {
+            return false;
+        }
+        let Some(last) = last else {
+            return false;
+        };
+        let moved: f64 = self
+            .omega
+            .iter()
+            .zip(a.iter().zip(&last.a))
+            .map(|(w, (x, y))| w * (x - y).abs())
+            .sum();
+        last.max + moved < -CLEAR_MARGIN
+    }
+}
+
+impl LastRows {
+    /// Records a sample's rows at coefficients `a` (its shape just evaluated) in `slot`.
+    pub(super) fn record(slot: &mut Option<LastRows>, a: &[f64], rows: &[f64]) {
         let max = rows.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        match &mut self.last[j] {
+        match slot {
             Some(last) => {
                 last.a.copy_from_slice(a);
                 last.rows.copy_from_slice(rows);
@@ -93,25 +112,8 @@ impl ClearSamples {
         }
     }
 
-    /// Sample `j`'s last recorded rows.
-    pub(super) fn rows(&self, j: usize) -> &[f64] {
-        &self.last[j].as_ref().expect("a kept sample has rows").rows
-    }
-
-    /// Whether sample `j` (interior sample `i`) may keep its last rows at coefficients `a`.
-    pub(super) fn clear(&self, i: usize, j: usize, a: &[f64]) -> bool {
-        if !self.free[i] {
-            return false;
-        }
-        let Some(last) = &self.last[j] else {
-            return false;
-        };
-        let moved: f64 = self
-            .omega
-            .iter()
-            .zip(a.iter().zip(&last.a))
-            .map(|(w, (x, y))| w * (x - y).abs())
-            .sum();
-        last.max + moved < -CLEAR_MARGIN
+    /// The recorded rows.
+    pub(super) fn rows(&self) -> &[f64] {
+        &self.rows
     }
 }

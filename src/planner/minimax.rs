@@ -15,7 +15,7 @@
 use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weighted_curvature};
 use crate::kernels::all_zero;
 use crate::optim::{Nlp, Sense};
-use crate::planner::clear_samples::ClearSamples;
+use crate::planner::clear_samples::{ClearSamples, LastRows};
 use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
 use crate::planner::workers::{JOB_GRADIENT, JOB_HESSIAN, JOB_VALUES, Workers};
@@ -99,6 +99,8 @@ struct SampleWork {
     rows_kept: bool,
     /// Whether its shape was left out at the last evaluation (the same).
     left_out: bool,
+    /// Its rows at its last evaluated shape, while rows may be kept (the same).
+    last: Option<LastRows>,
     adj: Adjoint,
 }
 
@@ -144,6 +146,7 @@ impl MinimaxProblem {
                 y: vec![0.0; per],
                 rows_kept: false,
                 left_out: false,
+                last: None,
                 adj: Adjoint::new(&model),
             })
             .collect();
@@ -226,6 +229,9 @@ impl MinimaxProblem {
             });
         // The energy needs no shape: the constant quadratic form of a weightless rod.
         let shapes_optional = m.loads.is_empty() && !m.energy_roots.is_empty();
+        for w in &mut self.work {
+            w.last = None;
+        }
         self.skip = match (eligible, m.position_bound_weights()) {
             (true, Some(omega)) => Some(ClearSamples::new(
                 omega,
@@ -428,7 +434,7 @@ impl Nlp for MinimaxProblem {
             && self.skip.as_ref().is_some_and(|sk| sk.shapes_optional);
         let rows_only = !light && self.swept.is_none() && self.skip.is_some();
         // Sample by sample: the coefficients, whether the shape stays left out, the shape, the
-        // energy and the rows.
+        // energy, the rows and, while rows may be kept, their record.
         {
             let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
             let (path, ks, skip, objective) = (&self.path, &self.ks, &self.skip, self.objective);
@@ -438,7 +444,7 @@ impl Nlp for MinimaxProblem {
                     for ((i, ai), w) in a.iter_mut().enumerate().zip(work.iter_mut()) {
                         path.shape_at(z, ks[j0 + i], ai);
                         w.left_out = match (skip, w.interior) {
-                            (Some(sk), Some(ii)) if light => sk.clear(ii, j0 + i, ai),
+                            (Some(sk), Some(ii)) if light => sk.clear(ii, w.last.as_ref(), ai),
                             (Some(_), None) => light,
                             _ => false,
                         };
@@ -449,13 +455,18 @@ impl Nlp for MinimaxProblem {
                         let t = model.energy(&a[i], shape, objective, Some(&mut w.gu));
                         w.u = t.value(objective);
                         w.rows_kept = match (skip, w.interior) {
-                            (Some(sk), Some(ii)) if rows_only => sk.clear(ii, j0 + i, &a[i]),
+                            (Some(sk), Some(ii)) if rows_only => {
+                                sk.clear(ii, w.last.as_ref(), &a[i])
+                            }
                             _ => false,
                         };
                         if w.interior.is_some() && !w.rows_kept && !w.left_out {
                             for (b, blk) in blocks.iter().enumerate() {
                                 let rows = &mut w.rows[offsets[b]..offsets[b + 1]];
                                 blk.values(model, &a[i], shape, rows);
+                            }
+                            if skip.is_some() {
+                                LastRows::record(&mut w.last, &a[i], &w.rows);
                             }
                         }
                     }
@@ -469,17 +480,13 @@ impl Nlp for MinimaxProblem {
             }
             if w.interior.is_some() {
                 let rows = &mut c[row..row + per];
-                match &mut self.skip {
-                    Some(sk) if sk.stale[j] || w.rows_kept => {
+                match (&mut self.skip, &w.last) {
+                    // Kept (or left out): the rows last recorded.
+                    (Some(sk), Some(last)) if sk.stale[j] || w.rows_kept => {
                         sk.rows_kept += 1;
-                        rows.copy_from_slice(sk.rows(j));
+                        rows.copy_from_slice(last.rows());
                     }
-                    skip => {
-                        rows.copy_from_slice(&w.rows);
-                        if let Some(sk) = skip {
-                            sk.record(j, &self.a[j], rows);
-                        }
-                    }
+                    _ => rows.copy_from_slice(&w.rows),
                 }
                 row += per;
             }
@@ -507,7 +514,11 @@ impl Nlp for MinimaxProblem {
         }
         let nk = self.ks.len() as f64;
         let n_sample_rows = self.sample_rows();
-        let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&j| &self.shapes[j]).collect();
+        // Only the swept rows read the interior shapes as a list.
+        let interior_shapes: Vec<&Shape> = match &self.swept {
+            Some(_) => self.interior.iter().map(|&j| &self.shapes[j]).collect(),
+            None => Vec::new(),
+        };
         let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
         let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
         let (swept, targets) = (&self.swept, &self.targets);
