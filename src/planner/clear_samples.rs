@@ -12,9 +12,8 @@ const CLEAR_MARGIN: f64 = 1e-6;
 
 /// What lets [`crate::planner::minimax::MinimaxProblem`] skip a sample's rows (and shape); each
 /// sample keeps its own last rows ([`LastRows`]), so that the thread evaluating it records and
-/// tests them. On a
-/// rod whose positions depend on θ alone (planar, inextensible, fixed base), with obstacle rows
-/// only, a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
+/// tests them. On a rod whose positions depend on θ alone (planar, inextensible, fixed base),
+/// with obstacle rows only, a row value `c = clearance − d(x)/L` changes by at most the boundary's displacement,
 /// which is at most `Σᵢ ωᵢ |aᵢ − a′ᵢ|` ([`crate::rod::model::Model::position_bound_weights`]).
 /// A sample whose rows all have zero multipliers and whose largest row, at the coefficients of
 /// its last evaluated rows, plus that bound is below `−CLEAR_MARGIN` keeps its last rows. Where
