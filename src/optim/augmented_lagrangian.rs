@@ -252,12 +252,7 @@ fn augment_inequalities(
     const BLOCK: usize = 8;
     let (y, lam) = (&y[..m], &lam[..m]);
     for (yb, lb) in y.chunks(BLOCK).zip(lam.chunks(BLOCK)) {
-        // Whether every `y` and `λ` of the block is ±0 (the sign bit shifted out).
-        let any = yb
-            .iter()
-            .zip(lb)
-            .fold(0u64, |acc, (t, l)| acc | ((t.to_bits() | l.to_bits()) << 1));
-        if any == 0 {
+        if crate::kernels::all_zero(yb) && crate::kernels::all_zero(lb) {
             continue;
         }
         for (&t, &l) in yb.iter().zip(lb) {

@@ -148,9 +148,7 @@ impl Nlp for StaticProblem {
     fn hessian_is_exact(&self, y: &[f64]) -> bool {
         self.constraints.iter().enumerate().all(|(k, con)| {
             !matches!(con, Constraint::SelfContact(_))
-                || y[self.offsets[k]..self.offsets[k + 1]]
-                    .iter()
-                    .all(|v| *v == 0.0)
+                || crate::kernels::all_zero(&y[self.offsets[k]..self.offsets[k + 1]])
         })
     }
     /// The energy's exact Hessian, the constraints' curvature through the positions, and the
