@@ -49,12 +49,14 @@ pub(super) struct Curvature {
 
 /// Where a start's sharpness stages begin: at stage `stage`, and, where the stages carry the
 /// curvature ([`Planner::stages_carry_curvature`]), from `curvature`; or, given `first`, after
-/// that first stage, already run.
+/// that first stage, already run. `spent` is the objective evaluations the start has already
+/// used (a refinement's rerun): the evaluation budget ([`Planner::over_budget`]) counts them.
 #[derive(Clone, Default)]
 pub(super) struct Resume {
     pub(super) stage: usize,
     pub(super) curvature: Curvature,
     pub(super) first: Option<Arc<FirstStage>>,
+    pub(super) spent: usize,
 }
 
 /// A quick start's first sharpness stage, where it ran as a start of the case's own attempt
@@ -189,7 +191,7 @@ impl Planner {
             lambda: None,
             status: AlStatus::IterationLimit,
             violation: f64::INFINITY,
-            evaluations: 0,
+            evaluations: from.spent,
         };
         let al = self.stage_options();
         let mut z = z0;
@@ -449,16 +451,15 @@ impl Planner {
             // Warm: only the sharpest stage again.
             let last = self.settings.sharpness.len() - 1;
             // A quick start's rerun starts from the curvature and penalty its stages carried.
+            // The rerun's evaluations count towards the start's budget: it continues from the
+            // evaluations the start has used, and its own include them.
             let from = Resume {
                 stage: last,
                 curvature: chosen.curvature.clone(),
                 first: None,
+                spent: chosen.evaluations,
             };
-            let r = self.optimise_from(start, chosen.z.clone(), &ks, from, workers, sink);
-            chosen = StartRun {
-                evaluations: chosen.evaluations + r.evaluations,
-                ..r
-            };
+            chosen = self.optimise_from(start, chosen.z.clone(), &ks, from, workers, sink);
             ver = check(&chosen.z);
         }
         if let Some((kr, kv)) = kept
@@ -476,5 +477,48 @@ impl Planner {
             verification: ver,
             added,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refinement's rerun counts the evaluations its start used before it: one that starts a
+    /// single evaluation short of the budget runs its stage (a stage in progress finishes) and
+    /// then no tracking round, where the same rerun with the budget unused tracks.
+    #[test]
+    fn a_rerun_counts_the_evaluations_its_start_used() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("planning_cases/plan_paper_planar.json");
+        let case = crate::case::load(&file).expect("the shipped case loads");
+        let mut p = crate::planner::Planner::from_case(&case).expect("the shipped case plans");
+        // Tracking runs until the samples lie on their equilibria (the case stops it early).
+        p.settings.equilibrium_stop = Some(0.0);
+        let budget = 1_000_000;
+        p.budget = Some(budget);
+        let n = p.path().n_vars();
+        let z0: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+        let ks: Vec<f64> = (0..41).map(|j| f64::from(j) / 40.0).collect();
+        let last = p.settings.sharpness.len() - 1;
+        let rerun = |spent: usize| {
+            let from = Resume {
+                stage: last,
+                spent,
+                ..Resume::default()
+            };
+            p.optimise_from(0, z0.clone(), &ks, from, &Workers::serial(), &mut |_, _| {})
+        };
+        let fresh = rerun(0);
+        assert!(fresh.tracking_rounds > 0, "the control does not track");
+        let late = rerun(budget - 1);
+        // The same stage ran (at least one evaluation), and nothing after it.
+        let stage = late
+            .evaluations
+            .checked_sub(budget - 1)
+            .expect("the rerun's evaluations include its start's");
+        assert!(stage > 0);
+        assert!(fresh.evaluations > stage, "{} {stage}", fresh.evaluations);
+        assert_eq!(late.tracking_rounds, 0);
     }
 }
