@@ -18,8 +18,9 @@ use crate::optim::{Nlp, Sense};
 use crate::planner::clear_samples::{ClearSamples, LastRows};
 use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
-use crate::planner::workers::{JOB_GRADIENT, JOB_HESSIAN, JOB_HESSIAN_SUM, JOB_VALUES, Workers};
+use crate::planner::workers::{JOB_GRADIENT, JOB_HESSIAN, JOB_VALUES, Workers};
 use crate::rod::energy::Objective;
+use crate::rod::hessian::add_rank_one;
 use crate::rod::kinematics::Shape;
 use crate::rod::model::Model;
 
@@ -644,13 +645,27 @@ impl Nlp for MinimaxProblem {
                 for (b, v) in gbar.iter_mut().zip(&w.gz) {
                     *b += self.weights[j] * v;
                 }
+                self.path.add_projected_hessian(&w.hm, self.ks[j], 1.0, h);
             }
         }
-        // The rank-one parts, in the order they are added: the travel term's Gauss–Newton part
-        // (for each interval, `w/Δk DᵀD` with `D` the z-Jacobian of `x(kⱼ₊₁) − x(kⱼ)`, from
-        // the end positions' z-Jacobians at the interior samples the chunks computed; the
-        // path's ends are fixed and contribute none), then the softmax part.
-        let mut travel_rows: Vec<(f64, Vec<f64>)> = Vec::new();
+        if let Some(sw) = &self.swept {
+            let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
+            let a: Vec<&[f64]> = self.interior.iter().map(|&i| &self.a[i][..]).collect();
+            sw.add_coupling_hessian(
+                &self.model,
+                &self.path,
+                &self.blocks,
+                &kin,
+                &a,
+                &interior_shapes,
+                &y[ns..],
+                &s[ns..],
+                h,
+            );
+        }
+        // The travel term's Gauss–Newton part: for each interval, `w/Δk DᵀD` with `D` the
+        // z-Jacobian of `x(kⱼ₊₁) − x(kⱼ)` (the path's ends are fixed and contribute none).
+        // (The z-Jacobians of the end's position at the interior samples, from the chunks.)
         if self.travel_weight != 0.0 {
             let jac = |j: usize| {
                 let w = &self.work[j];
@@ -666,75 +681,13 @@ impl Nlp for MinimaxProblem {
                     if let Some(r) = jac(j) {
                         d.iter_mut().zip(&r[c]).for_each(|(v, x)| *v -= x);
                     }
-                    travel_rows.push((w, d));
+                    add_rank_one(h, w, &d);
                 }
             }
         }
-        let rank_one: Vec<(f64, &[f64])> = travel_rows
-            .iter()
-            .map(|(w, d)| (*w, &d[..]))
-            .chain(
-                self.work
-                    .iter()
-                    .zip(&self.weights)
-                    .filter(|(w, _)| w.interior.is_some())
-                    .map(|(w, &wj)| (self.beta * wj, &w.gz[..])),
-            )
-            .chain(std::iter::once((-self.beta, &gbar[..])))
-            .collect();
-        // Each row of `h` is summed on its own (shared over the threads in chunks of rows),
-        // every entry adding the same terms in the same order as whole-matrix passes would:
-        // the samples' projections in sample order, the swept rows' coupling (whole-matrix,
-        // between the two), then the rank-one parts.
-        let projections: Vec<(&[f64], Vec<f64>)> = self
-            .work
-            .iter()
-            .zip(&self.ks)
-            .filter(|(w, _)| w.interior.is_some())
-            .map(|(w, &k)| (&w.hm[..], self.path.term_weights(k)))
-            .collect();
-        let path = &self.path;
-        let sum_rows = |h: &mut [f64], projected: bool, rank_ones: &[(f64, &[f64])]| {
-            let mut rows: Vec<&mut [f64]> = h.chunks_mut(nv).collect();
-            self.workers
-                .for_each_chunk(JOB_HESSIAN_SUM, &mut rows, |a0, rows| {
-                    for (i, row) in rows.iter_mut().enumerate() {
-                        let a = a0 + i;
-                        if projected {
-                            for (m, tw) in &projections {
-                                path.add_projected_hessian_row(m, tw, a, row);
-                            }
-                        }
-                        for &(w, d) in rank_ones {
-                            let wa = w * d[a];
-                            if wa != 0.0 {
-                                for (hv, db) in row.iter_mut().zip(d) {
-                                    *hv += wa * db;
-                                }
-                            }
-                        }
-                    }
-                });
-        };
-        match &self.swept {
-            None => sum_rows(h, true, &rank_one),
-            Some(sw) => {
-                sum_rows(h, true, &[]);
-                let kin: Vec<f64> = self.interior.iter().map(|&i| self.ks[i]).collect();
-                let a: Vec<&[f64]> = self.interior.iter().map(|&i| &self.a[i][..]).collect();
-                sw.add_coupling_hessian(
-                    &self.model,
-                    &self.path,
-                    &self.blocks,
-                    &kin,
-                    &a,
-                    &interior_shapes,
-                    &y[ns..],
-                    &s[ns..],
-                    h,
-                );
-                sum_rows(h, false, &rank_one);
-            }
+        for (j, w) in self.work.iter().enumerate() {
+            add_rank_one(h, self.beta * self.weights[j], &w.gz);
         }
+        add_rank_one(h, -self.beta, &gbar);
     }
 }

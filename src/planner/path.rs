@@ -186,27 +186,6 @@ impl DeformationPath {
         }
     }
 
-    /// The weights `kⁱ (1 − k)` of the terms `i = 1..=m` at `k` ([`DeformationPath::weight`]).
-    pub fn term_weights(&self, k: f64) -> Vec<f64> {
-        (0..self.terms).map(|i| Self::weight(i + 1, k)).collect()
-    }
-
-    /// Row `a` of [`DeformationPath::add_projected_hessian`] with `scale` 1, for the term
-    /// weights `tw` at `k` ([`DeformationPath::term_weights`]): adds to `row` (length `n_vars`)
-    /// the same terms, in the same order, as that function adds to row `a` of `h_z`.
-    pub fn add_projected_hessian_row(&self, m: &[f64], tw: &[f64], a: usize, row: &mut [f64]) {
-        let r = self.basis.len();
-        let (i, p) = (a / r, a % r);
-        let wi = tw[i];
-        let mp = &m[p * r..(p + 1) * r];
-        for (seg, &wi2) in row.chunks_exact_mut(r).zip(tw) {
-            let w = wi * wi2;
-            for (hv, mv) in seg.iter_mut().zip(mp) {
-                *hv += w * mv;
-            }
-        }
-    }
-
     /// Adds the chain rule at `k` for a projected matrix `m` ([`DeformationPath::project_hessian`]),
     /// times `scale`, to `h_z`.
     pub fn add_projected_hessian(&self, m: &[f64], k: f64, scale: f64, h_z: &mut [f64]) {
@@ -229,45 +208,4 @@ impl DeformationPath {
 
 crate::kernels::wide::dispatch! {
     fn shape_at(p: &DeformationPath, z: &[f64], k: f64, out: &mut [f64]) => DeformationPath::shape_at_body
-}
-
-#[cfg(test)]
-mod tests {
-    use super::DeformationPath;
-
-    /// Row by row, [`DeformationPath::add_projected_hessian_row`] adds to every entry what
-    /// [`DeformationPath::add_projected_hessian`] (scale 1) adds, bit for bit, over several
-    /// samples in turn.
-    #[test]
-    fn projected_hessian_rows_match_the_whole_matrix() {
-        let n = 5;
-        // A fixed first coefficient: four admissible directions.
-        let path =
-            DeformationPath::new(vec![0.1; n], vec![-0.2; n], 3, &[vec![1.0, 0., 0., 0., 0.]]);
-        let r = path.basis.len();
-        let nv = path.n_vars();
-        let ms: Vec<(f64, Vec<f64>)> = [0.1, 0.37, 0.9]
-            .iter()
-            .enumerate()
-            .map(|(s, &k)| {
-                let m = (0..r * r)
-                    .map(|i| ((i * 7 + s * 3) as f64 * 0.731).sin() * 1e3)
-                    .collect();
-                (k, m)
-            })
-            .collect();
-        let start: Vec<f64> = (0..nv * nv).map(|i| (i as f64 * 0.17).cos()).collect();
-        let mut whole = start.clone();
-        for (k, m) in &ms {
-            path.add_projected_hessian(m, *k, 1.0, &mut whole);
-        }
-        let mut rows = start;
-        for (a, row) in rows.chunks_mut(nv).enumerate() {
-            for (k, m) in &ms {
-                path.add_projected_hessian_row(m, &path.term_weights(*k), a, row);
-            }
-        }
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&rows), bits(&whole));
-    }
 }

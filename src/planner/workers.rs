@@ -36,10 +36,8 @@ pub const JOB_HESSIAN: usize = 2;
 pub const JOB_VERIFY: usize = 3;
 /// See [`JOB_VALUES`].
 pub const JOB_EQUILIBRIA: usize = 4;
-/// The path Hessian's sums over the samples, row by row ([`super::minimax::MinimaxProblem`]).
-pub const JOB_HESSIAN_SUM: usize = 5;
 /// How many kinds of job there are.
-pub const KINDS: usize = JOB_HESSIAN_SUM + 1;
+pub const KINDS: usize = JOB_EQUILIBRIA + 1;
 
 /// Whether a kind of job runs shared or on the calling thread alone, by what each has cost
 /// lately. Sharing costs a hand-over, and a helper that looks for work slows a calling thread
