@@ -391,6 +391,19 @@ fn add_track_travel(
     tracked
 }
 
+/// The interior samples' shapes in sample order, as the swept rows read them: only they read
+/// the shapes as a list, so without swept rows the list is empty.
+fn swept_shapes<'a>(
+    swept: &Option<Swept>,
+    interior: &[usize],
+    shapes: &'a [Shape],
+) -> Vec<&'a Shape> {
+    match swept {
+        Some(_) => interior.iter().map(|&j| &shapes[j]).collect(),
+        None => Vec::new(),
+    }
+}
+
 /// `S_β(u)` and its weights `∂S/∂u_j` (a softmax).
 pub fn smoothed_max(u: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
     let umax = u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -492,7 +505,7 @@ impl Nlp for MinimaxProblem {
             }
         }
         if let Some(sw) = &self.swept {
-            let shapes: Vec<&Shape> = self.interior.iter().map(|&j| &self.shapes[j]).collect();
+            let shapes = swept_shapes(&self.swept, &self.interior, &self.shapes);
             let (rows, swept) = c.split_at_mut(row);
             sw.values(rows, per, &self.offsets, &shapes, swept);
         }
@@ -514,11 +527,7 @@ impl Nlp for MinimaxProblem {
         }
         let nk = self.ks.len() as f64;
         let n_sample_rows = self.sample_rows();
-        // Only the swept rows read the interior shapes as a list.
-        let interior_shapes: Vec<&Shape> = match &self.swept {
-            Some(_) => self.interior.iter().map(|&j| &self.shapes[j]).collect(),
-            None => Vec::new(),
-        };
+        let interior_shapes = swept_shapes(&self.swept, &self.interior, &self.shapes);
         let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
         let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
         let (swept, targets) = (&self.swept, &self.targets);
@@ -583,7 +592,7 @@ impl Nlp for MinimaxProblem {
         let tracked = self.targets.is_some() && self.track_weight > 0.0;
         // Softmax part: β (Σ w g gᵀ − ḡ ḡᵀ) with g the z-gradients of the samples.
         let mut gbar = vec![0.0; nv];
-        let interior_shapes: Vec<&Shape> = self.interior.iter().map(|&i| &self.shapes[i]).collect();
+        let interior_shapes = swept_shapes(&self.swept, &self.interior, &self.shapes);
         let ns = self.sample_rows();
         let n = self.model.n();
         let (model, blocks, offsets, path) = (&self.model, &self.blocks, &self.offsets, &self.path);
