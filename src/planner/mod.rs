@@ -1296,3 +1296,13 @@ impl Planner {
         }
     }
 }
+
+/// The planner of the shipped paper case (`planning_cases/plan_paper_planar.json`), for the
+/// planner's unit tests.
+#[cfg(test)]
+pub(crate) fn paper_planner() -> Planner {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("planning_cases/plan_paper_planar.json");
+    let case = crate::case::load(&file).expect("the shipped case loads");
+    Planner::from_case(&case).expect("the shipped case plans")
+}

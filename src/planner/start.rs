@@ -489,10 +489,7 @@ mod tests {
     /// then no tracking round, where the same rerun with the budget unused tracks.
     #[test]
     fn a_rerun_counts_the_evaluations_its_start_used() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("planning_cases/plan_paper_planar.json");
-        let case = crate::case::load(&file).expect("the shipped case loads");
-        let mut p = crate::planner::Planner::from_case(&case).expect("the shipped case plans");
+        let mut p = crate::planner::paper_planner();
         // Tracking runs until the samples lie on their equilibria (the case stops it early).
         p.settings.equilibrium_stop = Some(0.0);
         let budget = 1_000_000;

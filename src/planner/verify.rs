@@ -444,10 +444,7 @@ mod tests {
     /// `skip_inside`.
     #[test]
     fn verification_is_the_same_on_any_number_of_threads() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("planning_cases/plan_paper_planar.json");
-        let case = crate::case::load(&file).expect("the shipped case loads");
-        let p = crate::planner::Planner::from_case(&case).expect("the shipped case plans");
+        let p = crate::planner::paper_planner();
         let fine = fine_model(&p.base.model, 256, 4);
         let path = p.path();
         let bent: Vec<f64> = (0..path.n_vars())
