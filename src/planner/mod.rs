@@ -1023,7 +1023,7 @@ impl Planner {
             // The best plan not replayed yet (a plan replayed and found not executable does
             // not stand in the way of the next attempt's).
             let Some(best) = (0..runs.len())
-                .filter(|i| !judged.iter().any(|(j, _)| j == i))
+                .filter(|&i| !runs[i].repeat && !judged.iter().any(|(j, _)| *j == i))
                 .max_by(|&i, &j| self.ranked(runs, i, j))
             else {
                 return false;

@@ -107,6 +107,11 @@ pub enum Attempt {
     Fallback,
     /// The case's path terms without the travel term (the paper's objective).
     WithoutTravel,
+    /// A plan of the quick attempt or the case's own that attains the lower bound on `U_max`
+    /// and is collision-free but not executable, lifted to the first fallback count's path
+    /// terms (the new terms zero, the same path) and optimised again from its sharpest stage:
+    /// its tracking pulls the shapes onto their equilibria with the extra terms' freedom.
+    Lifted,
 }
 
 impl Attempt {
@@ -117,6 +122,7 @@ impl Attempt {
             Attempt::Own => "own",
             Attempt::Fallback => "fallback",
             Attempt::WithoutTravel => "without_travel",
+            Attempt::Lifted => "lifted",
         }
     }
 }
@@ -373,6 +379,7 @@ mod tests {
             Attempt::Own,
             Attempt::Fallback,
             Attempt::WithoutTravel,
+            Attempt::Lifted,
         ] {
             assert_eq!(serde_json::to_value(a).expect("serialises"), a.name());
         }

@@ -106,6 +106,11 @@ pub struct PlanSettings {
     /// `false`: only the case's own attempt and those after it (no effect on a 3D rod, whose
     /// own stages carry the curvature).
     pub quick_attempt: bool,
+    /// Lift a plan of the quick attempt or the case's own that attains the lower bound on
+    /// `U_max` and is collision-free but not executable to the first fallback count's path
+    /// terms and optimise it again from its sharpest stage ([`super::Attempt::Lifted`]), before
+    /// the next attempt; `false`: never.
+    pub lift: bool,
 }
 
 /// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
@@ -166,6 +171,7 @@ impl Default for PlanSettings {
             workspace: None,
             straight_path_first: true,
             quick_attempt: true,
+            lift: true,
         }
     }
 }

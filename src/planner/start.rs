@@ -48,8 +48,9 @@ pub(super) struct Curvature {
 }
 
 /// Where a start's sharpness stages begin: at stage `stage`, and, where the stages carry the
-/// curvature ([`Planner::stages_carry_curvature`]), from `curvature`; or, given `first`, after
-/// that first stage, already run. `spent` is the objective evaluations the start has already
+/// curvature ([`Planner::stages_carry_curvature`]), from `curvature`; or, given `first`, from
+/// its path and results (a quick start's first stage, or a lifted plan taken as its stages'
+/// result, [`FirstStage::lifted`]). `spent` is the objective evaluations the start has already
 /// used (a refinement's rerun): the evaluation budget ([`Planner::over_budget`]) counts them.
 #[derive(Clone, Default)]
 pub(super) struct Resume {
@@ -71,6 +72,23 @@ pub(super) struct FirstStage {
     tally: Tally,
     /// The progress the stage reported, with each report's worst shape.
     progress: Vec<(Progress, Vec<f64>)>,
+}
+
+impl FirstStage {
+    /// A converged plan's path `z`, lifted to more path terms, with its sampled constraints'
+    /// `violation`, taken as a start's stages' result (the multipliers start at zero).
+    pub(super) fn lifted(z: Vec<f64>, violation: f64) -> FirstStage {
+        FirstStage {
+            z,
+            tally: Tally {
+                lambda: None,
+                status: AlStatus::Converged,
+                violation,
+                evaluations: 0,
+            },
+            progress: Vec::new(),
+        }
+    }
 }
 
 #[derive(Clone)]

@@ -5,18 +5,22 @@
 //! terms and the paper's objective, without the travel term, until a plan replayed after a
 //! group (the best not replayed yet) is executable (its replay coincides with it, or its
 //! replayed equilibria are a plan; after the quick attempt, only one that attains the lower
-//! bound on `U_max` ends the search); and which of the plans is the plan. Unless the case sets
+//! bound on `U_max` ends the search); and which of the plans is the plan. Where the quick
+//! attempt's or the case's own plan attains that bound and is collision-free but not
+//! executable, the same path with the first fallback count's path terms is tracked again
+//! before the next attempt ([`Attempt::Lifted`], once per search). Unless the case sets
 //! `swept_clearance`, the attempts after one whose plans all tunnel through an obstacle (other
 //! than the quick attempt) hold the swept rows.
 
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
 use super::result::Attempt;
-use super::start::{Resume, Verified};
+use super::start::{FirstStage, Resume, Verified};
 use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// One start's verified plan and the path-term count it was planned with.
 #[derive(Clone)]
@@ -35,6 +39,9 @@ pub(super) struct StartPlan {
     pub(super) swept_clearance: bool,
     /// The plan, verified and refined.
     pub(super) plan: Verified,
+    /// A lifted plan whose tracking kept no round: the path of the plan it was lifted from,
+    /// already judged, so it is not judged again (and that plan ranks before it).
+    pub(super) repeat: bool,
 }
 
 /// Judges the plans so far (told whether they come from the quick attempt): true when they are
@@ -182,7 +189,10 @@ impl Planner {
         // after it hold the swept rows that stop a point from crossing a thin obstacle between
         // two samples ([`super::PlanSettings::swept`]).
         let mut tunnelled = false;
-        'attempts: for (attempt, (kind, pl)) in attempts.enumerate() {
+        // Each attempt (a lifted one too) has `starts` indices, in the order they run.
+        let mut attempt = 0;
+        let mut lifted_once = false;
+        'attempts: for (kind, pl) in attempts {
             let pl = if tunnelled && self.settings.swept_clearance.is_none() {
                 Cow::Owned(pl.with_swept_clearance())
             } else {
@@ -249,6 +259,7 @@ impl Planner {
                             travel_weight: pl.settings.travel_weight,
                             swept_clearance: pl.settings.swept(),
                             plan,
+                            repeat: false,
                         }),
                 );
                 // Checked before the next group, and before the next fallback planner is made.
@@ -258,9 +269,100 @@ impl Planner {
                 if judge(&runs, kind == Attempt::Quick, observer) {
                     break 'attempts;
                 }
+                // A plan of this group at the lower bound, collision-free but not executable:
+                // the same path with more terms, tracked again (once per search).
+                let liftable = (!lifted_once)
+                    .then(|| self.lift(&runs[runs.len() - group.len()..], kind))
+                    .flatten();
+                if let Some((lifted, z, violation)) = liftable {
+                    lifted_once = true;
+                    attempt += 1;
+                    let run = self.run_lifted(
+                        &budget(lifted),
+                        attempt * starts,
+                        z,
+                        violation,
+                        fine,
+                        observer,
+                    );
+                    let repeat = run.repeat;
+                    runs.push(run);
+                    if self.stopped() || (!repeat && judge(&runs, false, observer)) {
+                        break 'attempts;
+                    }
+                }
             }
+            attempt += 1;
         }
         runs
+    }
+
+    /// Tracks, verifies and refines the lifted path `z` (its source's sampled constraints
+    /// violated by `violation`) with `lifted`'s path terms, as start `index`.
+    fn run_lifted(
+        &self,
+        lifted: &Planner,
+        index: usize,
+        z: Vec<f64>,
+        violation: f64,
+        fine: &Model,
+        observer: &mut dyn PlanObserver,
+    ) -> StartPlan {
+        let nk = self.settings.k_samples;
+        let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
+        // No sharpness stage: the source's converged path is taken as their result.
+        let from = Resume {
+            stage: self.settings.sharpness.len(),
+            first: Some(Arc::new(FirstStage::lifted(z.clone(), violation))),
+            ..Resume::default()
+        };
+        let path = lifted.path();
+        let check = |z: &[f64]| self.verify_on(fine, &path, z, false);
+        let plan = lifted
+            .optimise_starts(&[(index, z.clone(), from)], &uniform, &check, observer)
+            .pop()
+            .expect("one start");
+        StartPlan {
+            index,
+            attempt: Attempt::Lifted,
+            terms: lifted.settings.path_terms,
+            travel_weight: lifted.settings.travel_weight,
+            swept_clearance: lifted.settings.swept(),
+            // Tracking that kept no round leaves the source's path, replayed already.
+            repeat: plan.run.z == z,
+            plan,
+        }
+    }
+
+    /// The planner and lifted path of the best of `group`'s plans (an attempt of kind `kind`)
+    /// when it is collision-free, converged, settled and peaks at an end shape on the
+    /// verification grid, and the first fallback count has more path terms than it: that
+    /// count's planner (the same settings otherwise) and the path with the new terms zero.
+    fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<(Planner, Vec<f64>, f64)> {
+        if !matches!(kind, Attempt::Quick | Attempt::Own) || !self.settings.lift {
+            return None;
+        }
+        let terms = *self
+            .settings
+            .fallback_terms(self.base.model.layout.spatial)
+            .first()?;
+        let best = (0..group.len()).max_by(|&i, &j| self.ranked(group, i, j))?;
+        let r = &group[best];
+        let v = &r.plan;
+        let liftable = terms > r.terms
+            && v.run.settled
+            && v.run.status == crate::optim::AlStatus::Converged
+            && v.verification.collision_free(self.collision_tolerance())
+            && v.verification.peaks_at_an_end();
+        if !liftable {
+            return None;
+        }
+        let mut pl = self.with_terms(terms);
+        pl.settings.travel_weight = r.travel_weight;
+        pl.settings.swept_clearance = Some(r.swept_clearance);
+        let mut z = v.run.z.clone();
+        z.resize(pl.path().n_vars(), 0.0);
+        Some((pl, z, v.run.violation))
     }
 }
 
@@ -336,6 +438,32 @@ impl Planner {
                 .into_iter()
                 .map(|r| r.expect("every start ran"))
                 .collect()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// A path lifted to more path terms (the new terms' unknowns zero, as
+    /// [`super::Planner::lift`] makes it) is the same path: its shapes equal the source's at
+    /// every `k`, bit for bit.
+    #[test]
+    fn a_lifted_path_is_the_same_path() {
+        let planner = crate::planner::paper_planner();
+        let (from, to) = (planner.path(), planner.with_terms(6).path());
+        let z: Vec<f64> = super::noise(7, from.n_vars())
+            .into_iter()
+            .map(|v| 0.3 * v)
+            .collect();
+        let mut lifted = z.clone();
+        lifted.resize(to.n_vars(), 0.0);
+        let n = from.n();
+        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..=40 {
+            let k = f64::from(j) / 40.0;
+            from.shape_at(&z, k, &mut a);
+            to.shape_at(&lifted, k, &mut b);
+            assert_eq!(a, b, "k = {k}");
         }
     }
 }

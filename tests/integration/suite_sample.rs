@@ -170,6 +170,50 @@ fn a_quick_plan_at_the_lower_bound_ends_the_search() {
     );
 }
 
+/// The suite's planar problem `planar_7_9` (seed 7), planned with the defaults: the quick
+/// attempt's plan attains the lower bound on U_max and is collision-free, but its sampled
+/// shapes lie farther than the coincidence tolerance from their equilibria (2.4 % of L
+/// measured). The same path lifted to the first fallback count's path terms and tracked again
+/// coincides with its replay, so it is the plan and the case's own attempt does not run.
+/// Checked independently of the planner's grid: on 801 values of k and 1024 intervals in s the
+/// plan's largest energy is the larger end energy (to 1e-9 relative) and its clearance at
+/// least −1e-6 L; without the lift (`"lift": false`) the search runs the case's own attempt
+/// and finds no lower U_max (to 1e-9).
+#[test]
+fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
+    use dlo_planner::planner::Attempt;
+    let (p, r) = suite_planar_plan_of(7, 9);
+    let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Lifted]);
+    let (quick, lifted) = (&r.starts[0], &r.starts[1]);
+    let tol = r.replay.tolerance;
+    assert!(quick.collision_free);
+    assert!(
+        quick.equilibrium_deviation.expect("tracked") > tol,
+        "{quick:?}"
+    );
+    assert_eq!(r.chosen_start, Some(lifted.start));
+    let terms = p.settings.fallback_terms(false)[0];
+    assert_eq!((lifted.path_terms, r.path_terms), (terms, terms));
+    assert!(lifted.path_terms > quick.path_terms);
+    assert_eq!(r.executed_path(), Some("optimal"));
+    assert!(r.replay.coincide && r.replay.max_deviation_over_l <= tol);
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
+    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
+    assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    let (_, unlifted) = suite_planar_plan_with(7, 9, serde_json::json!({ "lift": false }));
+    assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
+    assert!(unlifted.starts.iter().any(|s| s.attempt == Attempt::Own));
+    assert!(
+        unlifted.u_max >= r.u_max * (1.0 - 1e-9),
+        "{} vs {}",
+        unlifted.u_max,
+        r.u_max
+    );
+}
+
 /// The suite's planar problem `planar_1_11` (seed 1), planned with the defaults: its optimal
 /// path is collision-free but its replay departs by 4.9 % of L, so the plan the gripper
 /// executes is the replayed equilibria along the optimal path's trajectory. Checked
