@@ -285,6 +285,14 @@ impl MinimaxProblem {
         j == 0 || j + 1 == n
     }
 
+    /// Whether the sampled energies at the last evaluated point peak inside the path more
+    /// than `fraction` of the larger end energy above it (never where that is not positive).
+    pub fn peaks_far_inside(&self, fraction: f64) -> bool {
+        let ends = self.u[0].max(self.u[self.u.len() - 1]);
+        let top = self.u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        ends > 0.0 && top > (1.0 + fraction) * ends
+    }
+
     /// Sampled shapes' coefficients at the last evaluated point.
     pub fn sampled(&self) -> &[Vec<f64>] {
         &self.a

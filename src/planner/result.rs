@@ -97,8 +97,9 @@ pub enum Attempt {
     /// A planar rod's first attempt: the first group of `parallel_starts` starts, with the
     /// case's path terms and objective, their sharpness stages carrying the optimiser's
     /// curvature and penalty from stage to stage and ending at the first converged stage whose
-    /// samples peak at an end shape. Its plan ends the search only when it is executable and
-    /// attains the lower bound on `U_max` (the larger end energy).
+    /// samples peak at an end shape (or inside the path, more than a quarter above the larger
+    /// end energy). Its plan ends the search only when it is executable and attains the lower
+    /// bound on `U_max` (the larger end energy).
     Quick,
     /// The case's own path terms and objective (on a planar rod, every stage restarting the
     /// optimiser's curvature and penalty).
