@@ -110,8 +110,9 @@ pub enum Attempt {
     WithoutTravel,
     /// A plan of the quick attempt or the case's own that attains the lower bound on `U_max`
     /// and is collision-free but not executable, lifted to the first fallback count's path
-    /// terms (the new terms zero, the same path) and optimised again from its sharpest stage:
-    /// its tracking pulls the shapes onto their equilibria with the extra terms' freedom.
+    /// terms (the new terms zero, the same path) and tracked again, with no sharpness stage:
+    /// tracking pulls the shapes onto their equilibria with the extra terms' freedom. Its
+    /// `status` is its tracking's, or its source's where no tracking round ran.
     Lifted,
 }
 

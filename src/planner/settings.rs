@@ -108,8 +108,8 @@ pub struct PlanSettings {
     pub quick_attempt: bool,
     /// Lift a plan of the quick attempt or the case's own that attains the lower bound on
     /// `U_max` and is collision-free but not executable to the first fallback count's path
-    /// terms and optimise it again from its sharpest stage ([`super::Attempt::Lifted`]), before
-    /// the next attempt; `false`: never.
+    /// terms and run equilibrium tracking on it again ([`super::Attempt::Lifted`]), before the
+    /// next attempt, once per plan; `false`: never.
     pub lift: bool,
 }
 
