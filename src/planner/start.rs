@@ -82,12 +82,12 @@ pub(super) struct FirstStage {
 
 impl FirstStage {
     /// A converged plan's path `z`, lifted to more path terms, with its sampled constraints'
-    /// `violation`, taken as a start's stages' result (the multipliers start at zero).
-    pub(super) fn lifted(z: Vec<f64>, violation: f64) -> FirstStage {
+    /// `violation` and its rows' multipliers `lambda`, taken as a start's stages' result.
+    pub(super) fn lifted(z: Vec<f64>, violation: f64, lambda: Option<Vec<f64>>) -> FirstStage {
         FirstStage {
             z,
             tally: Tally {
-                lambda: None,
+                lambda,
                 status: AlStatus::Converged,
                 violation,
                 evaluations: 0,
@@ -118,6 +118,9 @@ pub(super) struct StartRun {
     /// A quick start's first stage, where the case's own start from the same path may begin
     /// after it ([`FirstStage`]).
     pub(super) first_stage: Option<Arc<FirstStage>>,
+    /// The samples of `k` the path was optimised on, and the multipliers of their rows the
+    /// last solve ended with (none where nothing was solved).
+    pub(super) samples: Arc<(Vec<f64>, Option<Vec<f64>>)>,
 }
 
 impl StartRun {
@@ -138,6 +141,7 @@ impl StartRun {
             settled: true,
             curvature: Curvature::default(),
             first_stage: None,
+            samples: Arc::default(),
         }
     }
 }
@@ -379,6 +383,7 @@ impl Planner {
                 Curvature::default()
             },
             first_stage,
+            samples: Arc::new((ks.to_vec(), tally.lambda)),
         }
     }
 }

@@ -15,7 +15,7 @@
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
 use super::result::Attempt;
-use super::start::{FirstStage, Resume, Verified};
+use super::start::{FirstStage, Resume, StartRun, Verified};
 use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
@@ -274,14 +274,14 @@ impl Planner {
                 let liftable = (!lifted_once)
                     .then(|| self.lift(&runs[runs.len() - group.len()..], kind))
                     .flatten();
-                if let Some((lifted, z, violation)) = liftable {
+                if let Some((lifted, z, source)) = liftable {
                     lifted_once = true;
                     attempt += 1;
                     let run = self.run_lifted(
                         &budget(lifted),
                         attempt * starts,
                         z,
-                        violation,
+                        &source,
                         fine,
                         observer,
                     );
@@ -304,22 +304,26 @@ impl Planner {
         lifted: &Planner,
         index: usize,
         z: Vec<f64>,
-        violation: f64,
+        source: &StartRun,
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> StartPlan {
-        let nk = self.settings.k_samples;
-        let uniform: Vec<f64> = (0..nk).map(|j| j as f64 / (nk - 1) as f64).collect();
-        // No sharpness stage: the source's converged path is taken as their result.
+        // No sharpness stage: the source's converged path is taken as their result, on its
+        // samples, with its multipliers.
+        let (ks, lambda) = &*source.samples;
         let from = Resume {
             stage: self.settings.sharpness.len(),
-            first: Some(Arc::new(FirstStage::lifted(z.clone(), violation))),
+            first: Some(Arc::new(FirstStage::lifted(
+                z.clone(),
+                source.violation,
+                lambda.clone(),
+            ))),
             ..Resume::default()
         };
         let path = lifted.path();
         let check = |z: &[f64]| self.verify_on(fine, &path, z, false);
         let plan = lifted
-            .optimise_starts(&[(index, z.clone(), from)], &uniform, &check, observer)
+            .optimise_starts(&[(index, z.clone(), from)], ks, &check, observer)
             .pop()
             .expect("one start");
         StartPlan {
@@ -338,7 +342,7 @@ impl Planner {
     /// when it is collision-free, converged, settled and peaks at an end shape on the
     /// verification grid, and the first fallback count has more path terms than it: that
     /// count's planner (the same settings otherwise) and the path with the new terms zero.
-    fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<(Planner, Vec<f64>, f64)> {
+    fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<(Planner, Vec<f64>, StartRun)> {
         if !matches!(kind, Attempt::Quick | Attempt::Own) || !self.settings.lift {
             return None;
         }
@@ -362,7 +366,7 @@ impl Planner {
         pl.settings.swept_clearance = Some(r.swept_clearance);
         let mut z = v.run.z.clone();
         z.resize(pl.path().n_vars(), 0.0);
-        Some((pl, z, v.run.violation))
+        Some((pl, z, v.run.clone()))
     }
 }
 

@@ -489,10 +489,8 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
 /// fallback the verdict is negative. (Only an optimal path that coincides counts here,
 /// `"equilibrium_plans": false`; by default the quick start's plan, which peaks at the goal
 /// shape, departs from its replay but its replayed equilibria are a plan, and no other start
-/// runs. The scenario is the case's own attempt's, so the lift is left out, `"lift": false`:
-/// with it, the quick plan, which attains the lower bound and departs by 5.1 %, is lifted to
-/// six terms, and the lifted plan coincides with its replay, at the same U_max to 1e-9,
-/// so that no other attempt runs.)
+/// runs. The scenario is the case's own attempt's, so the lift of the quick plan, which
+/// attains the lower bound and departs by 5.1 %, is left out, `"lift": false`.)
 #[test]
 fn fallback_path_terms_make_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
@@ -512,20 +510,6 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
     assert_eq!(by_default.starts[0].attempt, Attempt::Quick);
     assert_eq!(by_default.k_at_u_max, 1.0);
     assert_eq!(by_default.executed_path(), Some("equilibria"));
-    let lifted = run(serde_json::json!({ "equilibrium_plans": false }));
-    let kinds: Vec<Attempt> = lifted.starts.iter().map(|s| s.attempt).collect();
-    assert_eq!(kinds, [Attempt::Quick, Attempt::Lifted]);
-    assert_eq!(lifted.chosen_start, Some(lifted.starts[1].start));
-    assert_eq!(lifted.path_terms, 6);
-    assert!(lifted.starts[0].equilibrium_deviation.expect("measured") > 0.02);
-    assert_eq!(lifted.executed_path(), Some("optimal"));
-    assert!(lifted.replay.coincide && lifted.replay.max_deviation_over_l <= 0.02);
-    let quick_u = lifted.starts[0].u_max;
-    assert!(
-        (lifted.u_max - quick_u).abs() <= 1e-9 * quick_u,
-        "{} vs {quick_u}",
-        lifted.u_max
-    );
     let r = run(serde_json::json!({ "equilibrium_plans": false, "lift": false }));
     assert_eq!(r.status, PlanStatus::Planned);
     let (later, chosen) = after_quick(&r);
