@@ -138,6 +138,21 @@ fn on_a_finer_grid(
     )
 }
 
+/// Checks the plan of `r` independently of the planner's grid (on 801 values of k and 1024
+/// intervals in s): its largest energy is the larger end energy, to 1e-9 relative (no path's
+/// can be lower, since every path passes through both end shapes), and its clearance is at
+/// least −1e-6 L.
+fn attains_the_bound_clear_of_obstacles(
+    p: &dlo_planner::planner::Planner,
+    r: &dlo_planner::planner::PlanResult,
+) {
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(p, r);
+    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
+    assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+}
+
 /// The suite's planar problem `planar_1_25` (seed 1), planned with the defaults: the quick
 /// attempt's plan peaks at an end shape and coincides with its replay, so it is the plan and
 /// the case's own attempt does not run. Checked independently of the planner's grid: on 801
@@ -155,11 +170,7 @@ fn a_quick_plan_at_the_lower_bound_ends_the_search() {
     assert_eq!(r.chosen_start, Some(0));
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= r.replay.tolerance);
-    let l = p.base.model.rod.length;
-    let v = on_a_finer_grid(&p, &r);
-    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
-    assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
-    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    attains_the_bound_clear_of_obstacles(&p, &r);
     let (_, own) = suite_planar_plan_with(1, 25, serde_json::json!({ "quick_attempt": false }));
     assert!(own.starts.iter().all(|s| s.attempt != Attempt::Quick));
     assert!(
@@ -198,11 +209,7 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
     assert!(lifted.path_terms > quick.path_terms);
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= tol);
-    let l = p.base.model.rod.length;
-    let v = on_a_finer_grid(&p, &r);
-    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
-    assert!(v.u_max <= ends * (1.0 + 1e-9), "{} vs {ends}", v.u_max);
-    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    attains_the_bound_clear_of_obstacles(&p, &r);
     let (_, unlifted) = suite_planar_plan_with(7, 9, serde_json::json!({ "lift": false }));
     assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
     assert!(unlifted.starts.iter().any(|s| s.attempt == Attempt::Own));
