@@ -134,8 +134,9 @@ impl Attempt {
 pub struct StartSummary {
     /// Start index, in the order the attempts run: the quick attempt's starts (planar rods),
     /// the case's own, then each fallback path-term count's, then those without the travel
-    /// term; each attempt has `starts` indices, used or not (the quick attempt uses its
-    /// first `parallel_starts`).
+    /// term, a lifted plan's ([`Attempt::Lifted`]) right after the group it was lifted from;
+    /// each attempt has `starts` indices, used or not (the quick attempt uses its first
+    /// `parallel_starts`, a lifted attempt its first).
     pub start: usize,
     /// The attempt the start belongs to.
     pub attempt: Attempt,

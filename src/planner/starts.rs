@@ -297,8 +297,8 @@ impl Planner {
         runs
     }
 
-    /// Tracks, verifies and refines the lifted path `z` (its source's sampled constraints
-    /// violated by `violation`) with `lifted`'s path terms, as start `index`.
+    /// Tracks, verifies and refines `z`, the path of `source`'s plan lifted to `lifted`'s path
+    /// terms, on `source`'s samples and from its multipliers, as start `index`.
     fn run_lifted(
         &self,
         lifted: &Planner,

@@ -490,7 +490,9 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
 /// `"equilibrium_plans": false`; by default the quick start's plan, which peaks at the goal
 /// shape, departs from its replay but its replayed equilibria are a plan, and no other start
 /// runs. The scenario is the case's own attempt's, so the lift of the quick plan, which
-/// attains the lower bound and departs by 5.1 %, is left out, `"lift": false`.)
+/// attains the lower bound and departs by 5.1 %, is left out, `"lift": false`; with it, the
+/// lift runs once, with six terms, right after the quick attempt, and every start keeps its
+/// own index, in the order the starts ran.)
 #[test]
 fn fallback_path_terms_make_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
@@ -510,6 +512,21 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
     assert_eq!(by_default.starts[0].attempt, Attempt::Quick);
     assert_eq!(by_default.k_at_u_max, 1.0);
     assert_eq!(by_default.executed_path(), Some("equilibria"));
+    // With the lift, the quick plan is lifted to six terms right after the quick attempt,
+    // and every start that runs has its own index, in the order the starts ran.
+    let lifted = run(serde_json::json!({ "equilibrium_plans": false }));
+    assert_eq!(lifted.starts[0].attempt, Attempt::Quick);
+    assert_eq!(lifted.starts[1].attempt, Attempt::Lifted);
+    assert_eq!(lifted.starts[1].path_terms, 6);
+    assert!(lifted.starts.windows(2).all(|w| w[0].start < w[1].start));
+    assert_eq!(
+        lifted
+            .starts
+            .iter()
+            .filter(|s| s.attempt == Attempt::Lifted)
+            .count(),
+        1
+    );
     let r = run(serde_json::json!({ "equilibrium_plans": false, "lift": false }));
     assert_eq!(r.status, PlanStatus::Planned);
     let (later, chosen) = after_quick(&r);
