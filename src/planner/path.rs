@@ -60,6 +60,14 @@ impl DeformationPath {
         self.terms * self.basis.len()
     }
 
+    /// The unknowns of path `z` (`terms` blocks `zᵢ`) with `to` terms: the blocks of the new
+    /// terms zero, so that the path, with the same basis, is the same (`to ≥ terms`).
+    pub fn lift(z: &[f64], terms: usize, to: usize) -> Vec<f64> {
+        let mut lifted = z.to_vec();
+        lifted.resize(z.len() / terms * to, 0.0);
+        lifted
+    }
+
     /// Weight `kⁱ (1 − k)` of term `i` (from 1).
     pub fn weight(i: usize, k: f64) -> f64 {
         k.powi(i as i32) * (1.0 - k)

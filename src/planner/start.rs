@@ -70,7 +70,8 @@ pub(super) struct Resume {
 /// from the same path would: from a scaled identity and the first penalty, and without the
 /// quick attempt's penalty hold ever taking effect ([`crate::optim::AlOutcome::penalty_held`]).
 /// The case's own start from the same path then begins after it, bit for bit where it would
-/// have been, and reports its progress again.
+/// have been, and reports its progress again. A lifted plan is taken as a start's stages'
+/// result the same way ([`FirstStage::lifted`]).
 pub(super) struct FirstStage {
     /// The path after the stage.
     z: Vec<f64>,

@@ -15,7 +15,7 @@
 use super::Planner;
 use super::observer::{PlanObserver, Progress};
 use super::result::Attempt;
-use super::start::{FirstStage, Resume, StartRun, Verified};
+use super::start::{FirstStage, Resume, Verified};
 use super::verify::{Verification, verify_grid};
 use crate::planner::path::DeformationPath;
 use crate::rod::model::Model;
@@ -42,6 +42,17 @@ pub(super) struct StartPlan {
     /// A lifted plan whose tracking kept no round: the path of the plan it was lifted from,
     /// already judged, so it is not judged again (and that plan ranks before it).
     pub(super) repeat: bool,
+}
+
+/// A plan to lift ([`Attempt::Lifted`]): the planner with the first fallback count's path
+/// terms (the plan's travel weight and swept rows), the plan's path with the new terms zero,
+/// its sampled constraints' violation, and its samples and multipliers
+/// ([`super::start::StartRun::samples`]).
+struct Lift {
+    planner: Planner,
+    z: Vec<f64>,
+    violation: f64,
+    samples: Arc<(Vec<f64>, Option<Vec<f64>>)>,
 }
 
 /// Judges the plans so far (told whether they come from the quick attempt): true when they are
@@ -102,6 +113,13 @@ impl Planner {
     fn quick(&self) -> Planner {
         let mut p = self.clone();
         p.quick = true;
+        p
+    }
+
+    /// `p` with the evaluation budget of the attempts after the case's own
+    /// (`fallback_evaluations`).
+    fn budgeted(&self, mut p: Planner) -> Planner {
+        p.budget = Some(self.settings.fallback_evaluations);
         p
     }
 
@@ -167,10 +185,7 @@ impl Planner {
         // evaluation budget. (On a 3D rod the case's own stages already carry the curvature.)
         let spatial = self.base.model.layout.spatial;
         let fallbacks = self.settings.fallback_terms(spatial);
-        let budget = |mut p: Planner| {
-            p.budget = Some(self.settings.fallback_evaluations);
-            Cow::Owned(p)
-        };
+        let budget = |p: Planner| Cow::Owned(self.budgeted(p));
         let attempts = (!spatial && self.settings.quick_attempt)
             .then(|| (Attempt::Quick, budget(self.quick())))
             .into_iter()
@@ -274,17 +289,10 @@ impl Planner {
                 let liftable = (!lifted_once)
                     .then(|| self.lift(&runs[runs.len() - group.len()..], kind))
                     .flatten();
-                if let Some((lifted, z, source)) = liftable {
+                if let Some(lift) = liftable {
                     lifted_once = true;
                     attempt += 1;
-                    let run = self.run_lifted(
-                        &budget(lifted),
-                        attempt * starts,
-                        z,
-                        &source,
-                        fine,
-                        observer,
-                    );
+                    let run = self.run_lifted(lift, attempt * starts, fine, observer);
                     let repeat = run.repeat;
                     runs.push(run);
                     if self.stopped() || (!repeat && judge(&runs, false, observer)) {
@@ -297,25 +305,30 @@ impl Planner {
         runs
     }
 
-    /// Tracks, verifies and refines `z`, the path of `source`'s plan lifted to `lifted`'s path
-    /// terms, on `source`'s samples and from its multipliers, as start `index`.
+    /// Tracks, verifies and refines `lift`'s path as start `index`, with its planner (on the
+    /// evaluation budget), on its source's samples and from its multipliers.
     fn run_lifted(
         &self,
-        lifted: &Planner,
+        lift: Lift,
         index: usize,
-        z: Vec<f64>,
-        source: &StartRun,
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> StartPlan {
+        let Lift {
+            planner,
+            z,
+            violation,
+            samples,
+        } = lift;
+        let lifted = self.budgeted(planner);
         // No sharpness stage: the source's converged path is taken as their result, on its
         // samples, with its multipliers.
-        let (ks, lambda) = &*source.samples;
+        let (ks, lambda) = &*samples;
         let from = Resume {
             stage: self.settings.sharpness.len(),
             first: Some(Arc::new(FirstStage::lifted(
                 z.clone(),
-                source.violation,
+                violation,
                 lambda.clone(),
             ))),
             ..Resume::default()
@@ -338,11 +351,10 @@ impl Planner {
         }
     }
 
-    /// The planner and lifted path of the best of `group`'s plans (an attempt of kind `kind`)
-    /// when it is collision-free, converged, settled and peaks at an end shape on the
-    /// verification grid, and the first fallback count has more path terms than it: that
-    /// count's planner (the same settings otherwise) and the path with the new terms zero.
-    fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<(Planner, Vec<f64>, StartRun)> {
+    /// The lift of the best of `group`'s plans (an attempt of kind `kind`) when it is
+    /// collision-free, converged, settled and peaks at an end shape on the verification grid,
+    /// and the first fallback count has more path terms than it.
+    fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<Lift> {
         if !matches!(kind, Attempt::Quick | Attempt::Own) || !self.settings.lift {
             return None;
         }
@@ -364,9 +376,12 @@ impl Planner {
         let mut pl = self.with_terms(terms);
         pl.settings.travel_weight = r.travel_weight;
         pl.settings.swept_clearance = Some(r.swept_clearance);
-        let mut z = v.run.z.clone();
-        z.resize(pl.path().n_vars(), 0.0);
-        Some((pl, z, v.run.clone()))
+        Some(Lift {
+            z: DeformationPath::lift(&v.run.z, r.terms, terms),
+            planner: pl,
+            violation: v.run.violation,
+            samples: Arc::clone(&v.run.samples),
+        })
     }
 }
 
@@ -448,7 +463,9 @@ impl Planner {
 
 #[cfg(test)]
 mod tests {
-    /// A path lifted to more path terms (the new terms' unknowns zero, as
+    use crate::planner::path::DeformationPath;
+
+    /// A path lifted to more path terms ([`DeformationPath::lift`], as
     /// [`super::Planner::lift`] makes it) is the same path: its shapes equal the source's at
     /// every `k`, bit for bit.
     #[test]
@@ -459,8 +476,8 @@ mod tests {
             .into_iter()
             .map(|v| 0.3 * v)
             .collect();
-        let mut lifted = z.clone();
-        lifted.resize(to.n_vars(), 0.0);
+        let lifted = DeformationPath::lift(&z, from.terms, to.terms);
+        assert_eq!(lifted.len(), to.n_vars());
         let n = from.n();
         let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
         for j in 0..=40 {
