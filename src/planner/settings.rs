@@ -111,7 +111,7 @@ pub struct PlanSettings {
     /// Lift a plan of the quick attempt or the case's own that attains the lower bound on
     /// `U_max` and is collision-free but not executable to the first fallback count's path
     /// terms and run equilibrium tracking on it again ([`super::Attempt::Lifted`]), before the
-    /// next attempt, once per plan; `false`: never.
+    /// next attempt, once per search; `false`: never.
     pub lift: bool,
 }
 
