@@ -425,9 +425,21 @@ pub fn load(path: &Path) -> Result<Case, Error> {
 
 /// Parses and validates case text; `path` names it in errors and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
-    let file: CaseFile = serde_json::from_str(text).map_err(|e| Error::Parse {
-        path: path.to_path_buf(),
-        message: e.to_string(),
+    let file: CaseFile = serde_json::from_str(text).map_err(|e| {
+        // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
+        // message for an array ("expected struct CaseFile with 16 elements") names nothing
+        // a user wrote.
+        let first = text.trim_start().chars().next();
+        let message = match first {
+            Some(c) if c != '{' && e.classify() == serde_json::error::Category::Data => {
+                format!("a case file is a JSON object (`{{ \"rod\": …, … }}`); this one starts with `{c}`")
+            }
+            _ => e.to_string(),
+        };
+        Error::Parse {
+            path: path.to_path_buf(),
+            message,
+        }
     })?;
     build(file, path)
 }

@@ -30,6 +30,16 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
     vec![
         ("not json", "this is not json".into(), "line 1 column"),
         ("empty file", "".into(), "EOF"),
+        (
+            "top-level array",
+            "[]".into(),
+            "a case file is a JSON object",
+        ),
+        (
+            "top-level number",
+            " 1.5".into(),
+            "this one starts with `1`",
+        ),
         ("missing rod", c(r#""planar": true"#), "missing field `rod`"),
         (
             "missing length",
