@@ -161,6 +161,11 @@ pub struct Planner {
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
     /// the case's own ([`PlanSettings::fallback_evaluations`]).
     budget: Option<usize>,
+    /// When the search must start nothing new ([`PlanSettings::time_limit`]); set on the
+    /// copy of the planner a run with a time limit works on.
+    deadline: Option<std::time::Instant>,
+    /// Set when the time limit stopped something from starting (that run's own flag).
+    timed_out: Arc<AtomicBool>,
     /// The quick first attempt of a planar rod ([`Attempt::Quick`]).
     quick: bool,
     /// Threads a start's path optimisation splits its samples over
@@ -826,6 +831,8 @@ impl Planner {
             linear_rows,
             stop: Arc::new(AtomicBool::new(false)),
             budget: None,
+            deadline: None,
+            timed_out: Arc::new(AtomicBool::new(false)),
             quick: false,
             workers: workers::Workers::new(settings.threads()),
             settings,
@@ -843,6 +850,19 @@ impl Planner {
     /// Whether the run has been asked to stop.
     pub(crate) fn stopped(&self) -> bool {
         self.stop.load(Ordering::Relaxed)
+    }
+
+    /// Whether the run's time limit has passed ([`PlanSettings::time_limit`]); asked only
+    /// where something new would start, so that `true` is recorded as the limit having ended
+    /// the search.
+    pub(crate) fn time_up(&self) -> bool {
+        let up = self
+            .deadline
+            .is_some_and(|d| std::time::Instant::now() >= d);
+        if up {
+            self.timed_out.store(true, Ordering::Relaxed);
+        }
+        up
     }
 
     /// Asks `observer` whether to stop, and sets the flag if so (on the run's own thread).
@@ -1063,8 +1083,29 @@ impl Planner {
 
     /// Optimises, verifies and replays the plan: the straight-line path when it already
     /// attains the lower bound on `U_max` and executes as it stands
-    /// ([`PlanSettings::straight_path_first`]), else the best of the starts.
+    /// ([`PlanSettings::straight_path_first`]), else the best of the starts. With
+    /// [`PlanSettings::time_limit`], the search starts nothing new once the limit has passed
+    /// (counted from this call) and judges the best plan found by then.
     pub fn run(&self, observer: &mut dyn PlanObserver) -> PlanResult {
+        match self.settings.time_limit {
+            // A copy with this run's own deadline and flag: runs of one planner do not share
+            // them.
+            // (A limit set after validation: none past a representable time, the search's
+            // first stage only at or below zero.)
+            Some(limit) => Planner {
+                deadline: std::time::Duration::try_from_secs_f64(limit.max(0.0))
+                    .ok()
+                    .and_then(|d| std::time::Instant::now().checked_add(d)),
+                timed_out: Arc::new(AtomicBool::new(false)),
+                ..self.clone()
+            }
+            .run_searched(observer),
+            None => self.run_searched(observer),
+        }
+    }
+
+    /// [`Planner::run`] on this planner's deadline.
+    fn run_searched(&self, observer: &mut dyn PlanObserver) -> PlanResult {
         let model = &self.base.model;
         observer.begin(model);
         observer.phase("endpoints");
@@ -1276,6 +1317,7 @@ impl Planner {
                     }
                 })
                 .collect(),
+            time_limit_reached: self.timed_out.load(Ordering::Relaxed),
             starts_not_run: self.settings.starts
                 - runs.iter().filter(|r| r.attempt == Attempt::Own).count(),
             path_terms,

@@ -214,10 +214,14 @@ pub struct PlanResult {
     pub verification: Verification,
     /// Every start that ran.
     pub starts: Vec<StartSummary>,
+    /// The time limit ([`super::PlanSettings::time_limit`]) ended the search: a sharpness
+    /// stage, refinement rerun, tracking round, group of starts or attempt that would have
+    /// run did not. The plan is the best one found before it.
+    pub time_limit_reached: bool,
     /// Starts of the case's own attempt ([`Attempt::Own`]) that did not run: with
     /// `parallel_starts` below `starts`, a group of starts runs only while no plan replayed so
     /// far is executable, and none runs after an executable quick plan that attains the lower
-    /// bound.
+    /// bound, or once the time limit has passed ([`PlanResult::time_limit_reached`]).
     pub starts_not_run: usize,
     /// Path terms `m` of the plan: the case's `path_terms`, or the fallback count its start
     /// used.

@@ -113,6 +113,16 @@ pub struct PlanSettings {
     /// terms and run equilibrium tracking on it again ([`super::Attempt::Lifted`]), before the
     /// next attempt, once per search; `false`: never.
     pub lift: bool,
+    /// Wall-clock seconds the search may take, counted from the start of
+    /// [`super::Planner::run`] (the end shapes, solved when the planner is made, are not
+    /// counted): once they have passed, nothing new starts — no further sharpness stage of a
+    /// start (its first always runs), refinement rerun, equilibrium-tracking round, group of
+    /// starts or attempt — and the best plan so far is judged by its replay as usual (the
+    /// replay is not limited; what is in progress finishes). A start cut short says
+    /// `iteration_limit`, and [`super::PlanResult::time_limit_reached`] says that the limit
+    /// ended the search. A plan under a time limit depends on the machine's speed; without
+    /// one (the default) it is the same bit for bit on any machine and number of threads.
+    pub time_limit: Option<f64>,
 }
 
 /// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
@@ -174,11 +184,15 @@ impl Default for PlanSettings {
             straight_path_first: true,
             quick_attempt: true,
             lift: true,
+            time_limit: None,
         }
     }
 }
 
 use crate::error::{Num, SettingsError};
+
+/// The largest [`PlanSettings::time_limit`] (seconds): beyond it, leave the limit out.
+pub const MAX_TIME_LIMIT: f64 = 1e6;
 
 /// The error for `field`.
 fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
@@ -304,6 +318,18 @@ impl PlanSettings {
             return Err(bad("energy_gap_tolerance", "must be non-negative"));
         }
         positive("coincide_tolerance", self.coincide_tolerance)?;
+        if let Some(t) = self.time_limit
+            && positive("time_limit", t)? > MAX_TIME_LIMIT
+        {
+            return Err(bad(
+                "time_limit",
+                format!(
+                    "must be at most {} s (a million seconds), got {}",
+                    Num(MAX_TIME_LIMIT),
+                    Num(t)
+                ),
+            ));
+        }
         if let Some(w) = &self.workspace {
             for i in 0..3 {
                 for (name, v) in [("min", w.min[i]), ("max", w.max[i])] {

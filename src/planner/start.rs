@@ -246,7 +246,8 @@ impl Planner {
         // A quick start's samples peak at an end shape at the current `z`, where measured.
         let mut at_end = None;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(from.stage) {
-            if self.over_budget(tally.evaluations) {
+            // (A start's first stage runs whatever the time.)
+            if self.over_budget(tally.evaluations) || (stage > from.stage && self.time_up()) {
                 tally.status = AlStatus::IterationLimit;
                 break;
             }
@@ -443,6 +444,7 @@ impl Planner {
                 || !chosen.settled
                 || self.stopped()
                 || self.over_budget(chosen.evaluations)
+                || self.time_up()
             {
                 break;
             }

@@ -258,6 +258,11 @@ impl Planner {
                 usize::MAX
             };
             for group in zs.chunks(self.settings.parallel_starts()).take(groups) {
+                // After the first group of the first attempt, nothing new starts once the time
+                // limit has passed.
+                if !runs.is_empty() && self.time_up() {
+                    break 'attempts;
+                }
                 let done = pl.optimise_starts(group, &uniform, &check, observer);
                 // (The quick attempt's plans are not refined when they peak inside the path, so
                 // their collisions say nothing about the case's own attempt.)
@@ -289,7 +294,7 @@ impl Planner {
                 let liftable = (!lifted_once)
                     .then(|| self.lift(&runs[runs.len() - group.len()..], kind))
                     .flatten();
-                if let Some(lift) = liftable {
+                if let Some(lift) = liftable.filter(|_| !self.time_up()) {
                     lifted_once = true;
                     attempt += 1;
                     let run = self.run_lifted(lift, attempt * starts, fine, observer);

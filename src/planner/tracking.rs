@@ -86,7 +86,7 @@ impl Planner {
             positions
         };
         for _ in 0..self.settings.equilibrium_rounds {
-            if self.stopped() || self.over_budget(tally.evaluations) {
+            if self.stopped() || self.over_budget(tally.evaluations) || self.time_up() {
                 break;
             }
             let targets: Vec<Vec<[f64; 3]>> = equilibria(p, z);

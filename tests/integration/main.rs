@@ -25,5 +25,6 @@ mod self_contact;
 mod suite;
 mod suite_sample;
 mod threads;
+mod time_limit;
 mod turned_scenes;
 mod wide_kernels;

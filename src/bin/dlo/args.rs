@@ -69,6 +69,11 @@ pub(crate) enum Command {
         /// gives each plan one unless this says otherwise.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
         threads: Option<u16>,
+        /// Seconds each plan's search may take (instead of the case's `plan.time_limit`): then
+        /// nothing new starts and the best plan so far is replayed and reported, with
+        /// `time_limit_reached` set.
+        #[arg(long, value_name = "SECONDS")]
+        time_limit: Option<f64>,
     },
     /// Disturbance force margin of a grasp (the case's `grasp` section, paper §6): `F_mub` for
     /// each friction coefficient, where and in which direction it is attained.

@@ -99,15 +99,28 @@ fn run() -> ExitCode {
             max_speed,
             max_angular_speed,
             threads,
+            time_limit,
         } => {
             let speeds = match speed_limits(max_speed, max_angular_speed) {
                 Ok(s) => s,
                 Err(code) => return code,
             };
+            if let Some(t) = time_limit
+                && !(t.is_finite()
+                    && t > 0.0
+                    && t <= dlo_planner::planner::settings::MAX_TIME_LIMIT)
+            {
+                eprintln!(
+                    "error: --time-limit: must be positive and at most {} s, got {t}",
+                    dlo_planner::planner::settings::MAX_TIME_LIMIT
+                );
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
             let mut extra = log_args(&log_dir, plot);
             for (flag, v) in [
                 ("--max-speed", max_speed),
                 ("--max-angular-speed", max_angular_speed),
+                ("--time-limit", time_limit),
             ] {
                 if let Some(v) = v {
                     extra.extend([flag.to_string(), v.to_string()]);
@@ -126,7 +139,7 @@ fn run() -> ExitCode {
                 extra.extend(["--threads".to_string(), t.to_string()]);
             }
             match single("plan", &cases, Some("plan"), json, jobs, &extra) {
-                Ok(case) => run_plan(&case, json, plot, &log_dir, speeds, threads),
+                Ok(case) => run_plan(&case, json, plot, &log_dir, speeds, threads, time_limit),
                 Err(code) => code,
             }
         }

@@ -70,6 +70,7 @@ pub(crate) fn run_plan(
     log_dir: &Path,
     speeds: Option<[f64; 2]>,
     threads: Option<u16>,
+    time_limit: Option<f64>,
 ) -> ExitCode {
     let c = match load(path) {
         Ok(c) => c,
@@ -82,6 +83,9 @@ pub(crate) fn run_plan(
         start_written = problem.start.shape.is_some();
         if let Some(t) = threads {
             settings.threads = Some(usize::from(t));
+        }
+        if time_limit.is_some() {
+            settings.time_limit = time_limit;
         }
         Planner::new(problem, settings)
     });
@@ -162,8 +166,9 @@ pub(crate) fn run_plan(
         PlanVerdict::SelfCollision => {
             let (gap, k) = result.verification.self_contact.unwrap_or((0.0, 0.0));
             eprintln!(
-                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}); {}",
+                "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}){}; {}",
                 path.display(),
+                time_limit_note(&result),
                 TRY_COLLISION
             );
             ExitCode::from(EXIT_COLLISION)
@@ -283,15 +288,26 @@ pub(crate) const TRY_COLLISION: &str = "try plan.swept_clearance: true, more pla
 pub(crate) const TRY_END_INSIDE: &str =
     "try an end pose farther from the obstacle, or more contact points (discretisation.samples)";
 
-/// Why the replayed equilibria are not a plan either, when they were checked.
+/// Why the replayed equilibria are not a plan either, when they were checked, and that the
+/// time limit ended the search, when it did.
 fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
-    result
+    let why = result
         .equilibrium_plan
         .as_ref()
         .and_then(|e| e.reason.as_ref())
         .map_or(String::new(), |why| {
             format!("; the replayed equilibria are not a plan either: {why}")
-        })
+        });
+    format!("{why}{}", time_limit_note(result))
+}
+
+/// That the time limit ended the search, when it did (appended to a failure's message).
+fn time_limit_note(result: &dlo_planner::planner::PlanResult) -> &'static str {
+    if result.time_limit_reached {
+        "; the search ended at its time limit (plan.time_limit, --time-limit) before it had tried everything: a longer limit may find a plan"
+    } else {
+        ""
+    }
 }
 
 /// What to try when the replay departs from the plan.
@@ -350,8 +366,13 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         let attempts = p.starts.iter().any(|s| s.attempt != p.starts[0].attempt);
         let not_run = if p.starts_not_run > 0 {
             format!(
-                " ({} more not run: an earlier plan is executable)",
-                p.starts_not_run
+                " ({} more not run: {})",
+                p.starts_not_run,
+                if p.time_limit_reached {
+                    "an earlier plan is executable, or the time limit ended the search"
+                } else {
+                    "an earlier plan is executable"
+                }
             )
         } else {
             String::new()
@@ -384,6 +405,12 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 })
                 .collect::<Vec<_>>()
                 .join(", ")
+        );
+    }
+    if p.time_limit_reached {
+        let _ = writeln!(
+            o,
+            "  time limit: the search ended at it; nothing new started after it, and the plan is the best found by then"
         );
     }
     let rp = &p.replay;
