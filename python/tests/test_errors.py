@@ -70,6 +70,7 @@ def test_plan_fields():
     goal = dlo.End.pose([-0.5, 0, 0.7], quaternion=[1, 0, 0, 0])
     assert field_of(lambda: dlo.plan(held, start, goal, settings={"path_terms": 0})) == "path_terms"
     assert field_of(lambda: dlo.plan(held, start, goal, settings={"k_sample": 5})) == "k_sample"
+    assert field_of(lambda: dlo.plan(held, start, goal, settings={"time_limit": -1.0})) == "time_limit"
     assert field_of(lambda: dlo.plan(held, start, goal, max_speed=-1.0)) == "max_speed"
     assert field_of(lambda: dlo.plan(held, dlo.End.shape([0.0] * 3), goal)) == "start"
     far = dlo.End.pose([5.0, 0, 0.7], quaternion=[1, 0, 0, 0])

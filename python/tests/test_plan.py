@@ -1,5 +1,6 @@
 """Plans from Python: equal to the CLI's, logged as the CLI logs, observed and stopped."""
 
+import json
 import math
 import subprocess
 import threading
@@ -46,6 +47,18 @@ def test_a_plan_equals_the_cli_report(dlo_bin, tmp_path, log_dir):
         return {t: (v["schema"], v["encoding"], v["messages"]) for t, v in found.items()}
 
     assert topics(log_dir / "plan_paper_planar.mcap") == topics(tmp_path / "plan_paper_planar.mcap")
+
+
+def test_a_time_limit_keeps_the_plan_found_by_then(dlo_bin, tmp_path, log_dir):
+    # A limit already passed when the paper's quick start ends its first stage: nothing runs
+    # after it, and its plan is judged as the CLI judges it with the same limit.
+    case = json.loads(PAPER.read_text())
+    case["plan"]["time_limit"] = 1e-9
+    plan = dlo.Case.parse(json.dumps(case), PAPER).plan(log_dir=log_dir)
+    cli = cli_json(dlo_bin, "plan", str(PAPER), "--time-limit", "1e-9", "--log-dir", str(tmp_path))
+    assert strip_files_and_timing(plan.to_dict()) == strip_files_and_timing(cli)
+    assert plan.time_limit_reached and [s.attempt for s in plan.starts] == ["quick"]
+    assert not dlo.Case.load(PAPER).plan().time_limit_reached
 
 
 def test_the_gripper_arrays_are_the_report():
