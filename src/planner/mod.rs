@@ -1089,9 +1089,8 @@ impl Planner {
     pub fn run(&self, observer: &mut dyn PlanObserver) -> PlanResult {
         match self.settings.time_limit {
             // A copy with this run's own deadline and flag: runs of one planner do not share
-            // them.
-            // (A limit set after validation: none past a representable time, the search's
-            // first stage only at or below zero.)
+            // them. (A limit set after validation: none where the deadline cannot be
+            // represented; the search's first stage only at or below zero.)
             Some(limit) => Planner {
                 deadline: std::time::Duration::try_from_secs_f64(limit.max(0.0))
                     .ok()

@@ -118,8 +118,9 @@ pub struct PlanSettings {
     /// counted): once they have passed, nothing new starts — no further sharpness stage of a
     /// start (its first always runs), refinement rerun, equilibrium-tracking round, group of
     /// starts or attempt — and the best plan so far is judged by its replay as usual (the
-    /// replay is not limited; what is in progress finishes). A start cut short says
-    /// `iteration_limit`, and [`super::PlanResult::time_limit_reached`] says that the limit
+    /// replay is not limited; what is in progress finishes). A start whose sharpness
+    /// stages are cut short says `iteration_limit` (one whose tracking or refinement is cut
+    /// keeps its stages' status), and [`super::PlanResult::time_limit_reached`] says that the limit
     /// ended the search. A plan under a time limit depends on the machine's speed; without
     /// one (the default) it is the same bit for bit on any machine and number of threads.
     pub time_limit: Option<f64>,
