@@ -82,6 +82,27 @@ fn a_start_cut_short_is_not_called_converged() {
     assert_eq!(r.status, PlanStatus::NotConverged);
 }
 
+/// Limits that pass while the paper's case is in its stages, tracking rounds or reruns (where
+/// each falls depends on the machine's speed): a stage or round cut there ends as unfinished
+/// (`iteration_limit`), never as a stopped run, and the plan found by then is still verified
+/// and replayed.
+#[test]
+fn a_limit_passed_mid_search_ends_it_as_unfinished_not_stopped() {
+    for limit in [0.002, 0.005, 0.01, 0.02, 0.05] {
+        let r = planned("plan_paper_planar.json", Some(limit));
+        assert_ne!(r.status, PlanStatus::Interrupted, "{limit}");
+        for s in &r.starts {
+            assert_ne!(
+                s.status,
+                dlo_planner::optim::AlStatus::Interrupted,
+                "{limit}"
+            );
+        }
+        assert!(!r.replay.steps.is_empty(), "{limit}: the replay ran");
+        assert!(r.u_max.is_finite() && r.chosen_start.is_some(), "{limit}");
+    }
+}
+
 #[test]
 fn bad_limits_are_refused_naming_the_field() {
     for (t, needle) in [
