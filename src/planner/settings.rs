@@ -120,9 +120,10 @@ pub struct PlanSettings {
     /// starts or attempt — and the best plan so far is judged by its replay as usual (the
     /// replay is not limited; what is in progress finishes). A start whose sharpness
     /// stages are cut short says `iteration_limit` (one whose tracking or refinement is cut
-    /// keeps its stages' status), and [`super::PlanResult::time_limit_reached`] says that the limit
-    /// ended the search. A plan under a time limit depends on the machine's speed; without
-    /// one (the default) it is the same bit for bit on any machine and number of threads.
+    /// keeps its stages' status), and [`super::PlanResult::time_limit_reached`] says that the
+    /// limit ended the search. A plan under a time limit depends on the machine's speed;
+    /// without one (the default) it is the same bit for bit on any machine and number of
+    /// threads.
     pub time_limit: Option<f64>,
 }
 
@@ -194,6 +195,23 @@ use crate::error::{Num, SettingsError};
 
 /// The largest [`PlanSettings::time_limit`] (seconds): beyond it, leave the limit out.
 pub const MAX_TIME_LIMIT: f64 = 1e6;
+
+/// Checks a [`PlanSettings::time_limit`] of `t` seconds: positive, finite and at most
+/// [`MAX_TIME_LIMIT`] (the error's field is `time_limit`; `dlo plan --time-limit` checks its
+/// value here too).
+pub fn check_time_limit(t: f64) -> Result<f64, SettingsError> {
+    if SettingsError::positive("time_limit", t)? > MAX_TIME_LIMIT {
+        return Err(bad(
+            "time_limit",
+            format!(
+                "must be at most {} s (a million seconds), got {}",
+                Num(MAX_TIME_LIMIT),
+                Num(t)
+            ),
+        ));
+    }
+    Ok(t)
+}
 
 /// The error for `field`.
 fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
@@ -319,17 +337,8 @@ impl PlanSettings {
             return Err(bad("energy_gap_tolerance", "must be non-negative"));
         }
         positive("coincide_tolerance", self.coincide_tolerance)?;
-        if let Some(t) = self.time_limit
-            && positive("time_limit", t)? > MAX_TIME_LIMIT
-        {
-            return Err(bad(
-                "time_limit",
-                format!(
-                    "must be at most {} s (a million seconds), got {}",
-                    Num(MAX_TIME_LIMIT),
-                    Num(t)
-                ),
-            ));
+        if let Some(t) = self.time_limit {
+            check_time_limit(t)?;
         }
         if let Some(w) = &self.workspace {
             for i in 0..3 {

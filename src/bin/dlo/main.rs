@@ -105,15 +105,8 @@ fn run() -> ExitCode {
                 Ok(s) => s,
                 Err(code) => return code,
             };
-            if let Some(t) = time_limit
-                && !(t.is_finite()
-                    && t > 0.0
-                    && t <= dlo_planner::planner::settings::MAX_TIME_LIMIT)
-            {
-                eprintln!(
-                    "error: --time-limit: must be positive and at most {} s, got {t}",
-                    dlo_planner::planner::settings::MAX_TIME_LIMIT
-                );
+            if let Some(Err(e)) = time_limit.map(dlo_planner::planner::settings::check_time_limit) {
+                eprintln!("error: --time-limit: {}", e.message);
                 return ExitCode::from(EXIT_BAD_INPUT);
             }
             let mut extra = log_args(&log_dir, plot);
