@@ -275,14 +275,13 @@ impl MinimaxProblem {
         &self.u
     }
 
-    /// Whether the largest sampled energy at the last evaluated point is at the first or the
-    /// last sample (`k = 0` or `k = 1`: an end shape's).
+    /// Whether the largest sampled energy at the last evaluated point is the first or the
+    /// last sample's (`k = 0` or `k = 1`: an end shape's), to rounding
+    /// ([`super::verify::attains_end_energy`]).
     pub fn peaks_at_an_end(&self) -> bool {
-        let n = self.u.len();
-        let j = (0..n)
-            .max_by(|&a, &b| self.u[a].total_cmp(&self.u[b]).then(b.cmp(&a)))
-            .expect("samples");
-        j == 0 || j + 1 == n
+        let ends = self.u[0].max(self.u[self.u.len() - 1]);
+        let top = self.u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        super::verify::attains_end_energy(top, ends)
     }
 
     /// Whether the sampled energies at the last evaluated point peak inside the path more

@@ -9,7 +9,10 @@
 //!    `θ = 0`): the interpolated path then keeps `θ` off the pole, where the angles degenerate;
 //! 2. `φ + ψ` nearest the reference's (the least extra twist);
 //! 3. `φ` nearest the written `φ` if the user wrote one, else the reference's `φ`; an exact tie
-//!    (the two mirror routes of a symmetric problem) takes the larger `φ`.
+//!    (the two mirror routes of a symmetric problem) takes the larger `φ`. A written `φ` more
+//!    than half a turn from the reference's is taken as its spelling nearest the reference's:
+//!    `φ` adding 2π with `ψ` taking it back is the same end frame, and continued from the
+//!    reference it would swing the rod once more about the reference's z axis.
 //!
 //! The reference is the held end's frame for the start and the start shape's end for the goal,
 //! so equivalent spellings of a pose give the same angles and the same plan.
@@ -35,6 +38,12 @@ pub fn tangent_twist(tangent: [f64; 3], twist: f64) -> Matrix {
     rotation(phi, theta, twist - phi)
 }
 
+/// How far past half a turn from the reference's `φ` a written `φ` is still taken as written
+/// (radians): the reference is a solved shape's end, which holds its pose to the solver's
+/// tolerance, so that a mirror-image goal written exactly half a turn from a start may lie a
+/// little past it.
+const HALF_TURN_SLACK: f64 = 1e-6;
+
 /// `x + 2πn` nearest `target`.
 pub(crate) fn nearest(x: f64, target: f64) -> f64 {
     x + TAU * ((target - x) / TAU).round()
@@ -53,7 +62,9 @@ pub fn euler_branch(m: Matrix, reference: [f64; 3], written_phi: Option<f64>) ->
     };
     // 2. φ + ψ nearest the reference's.
     let sum = nearest(f + p, rf + rp);
-    // 3. φ nearest the written (or the reference's) φ; an exact tie takes the larger.
+    // 3. φ nearest the written (or the reference's) φ; an exact tie takes the larger. A
+    //    written φ more than half a turn from the reference's is another spelling of one
+    //    nearer it (the same pose, without the extra swing about the reference's z axis).
     let target = written_phi.unwrap_or(rf);
     let lo = nearest(f, target);
     let hi = if lo < target { lo + TAU } else { lo - TAU };
@@ -61,6 +72,11 @@ pub fn euler_branch(m: Matrix, reference: [f64; 3], written_phi: Option<f64>) ->
         lo.max(hi)
     } else {
         lo
+    };
+    let phi = if (phi - rf).abs() > PI + HALF_TURN_SLACK {
+        nearest(f, rf)
+    } else {
+        phi
     };
     [phi, theta, sum - phi]
 }
@@ -128,6 +144,40 @@ mod tests {
             let got = euler_branch(mat, start, phi);
             for i in 0..3 {
                 assert!((got[i] - written[i]).abs() < 1e-12, "{got:?}");
+            }
+        }
+    }
+
+    /// A written φ a turn (or more than half a turn) from the reference's is the same frame
+    /// spelled another way: it takes the branch nearest the reference, where a written φ within
+    /// half a turn of it (a mirror-image goal's π or −π included) is kept.
+    #[test]
+    fn a_written_phi_past_half_a_turn_is_taken_nearest_the_reference() {
+        let start = [0.2, 0.4, 0.5];
+        for (written, phi) in [
+            ([0.2 + TAU, 0.4, 0.5 - TAU], 0.2),
+            ([0.2 - 2.0 * TAU, 0.4, 0.5 + 2.0 * TAU], 0.2),
+            ([-PI + 0.1, 0.7, 0.3], PI + 0.1),
+            ([PI + 0.1, 0.7, 0.3], PI + 0.1),
+            ([-PI + 0.3, 0.7, 0.3], -PI + 0.3),
+        ] {
+            let m = rotation(written[0], written[1], written[2]);
+            let got = euler_branch(m, start, Some(written[0]));
+            assert!(same(rotation(got[0], got[1], got[2]), m), "{got:?}");
+            assert!((got[0] - phi).abs() < 1e-12, "{written:?}: {got:?}");
+            assert!((got[1] - written[1]).abs() < 1e-12, "{written:?}: {got:?}");
+            // The least extra twist, as before.
+            assert!(
+                (got[0] + got[2] - (start[0] + start[2])).abs() <= PI,
+                "{got:?}"
+            );
+        }
+        // The mirror-image goal of the bar case, φ = ±π from a start at 0 (a little either side
+        // of it, as a solved start holds it), keeps the φ written.
+        for r in [-1e-8, 0.0, 1e-8] {
+            for w in [PI, -PI] {
+                let got = euler_branch(rotation(w, 0.4, -0.5 - w), [r, 0.4, 0.5], Some(w));
+                assert!((got[0] - w).abs() < 1e-12, "{w} from {r}: {got:?}");
             }
         }
     }

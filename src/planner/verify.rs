@@ -78,12 +78,27 @@ impl Verification {
             && self.self_contact.is_none_or(|(g, _)| g >= -tol)
     }
 
-    /// Whether the grid's largest energy is at `k = 0` or `k = 1`: the path attains the lower
-    /// bound on every path's `U_max` (the larger end energy), since every path passes through
-    /// both end shapes.
+    /// Whether the grid's largest energy is an end shape's (at `k = 0` or `k = 1`, to
+    /// rounding, [`attains_end_energy`]): the path attains the lower bound on every path's
+    /// `U_max` (the larger end energy), since every path passes through both end shapes.
     pub fn peaks_at_an_end(&self) -> bool {
-        self.k_at_u_max == 0.0 || self.k_at_u_max == 1.0
+        match (self.energies.first(), self.energies.last()) {
+            (Some(&first), Some(&last)) => attains_end_energy(self.u_max, first.max(last)),
+            _ => self.k_at_u_max == 0.0 || self.k_at_u_max == 1.0,
+        }
     }
+}
+
+/// Relative rounding within which a path's largest energy counts as its larger end energy.
+/// The energies inside a path whose shapes do not change (start and goal the same pose) differ
+/// from the ends' in their last bits (the samples' coefficients are `(1−k)a₀ + k·a₁`), and such
+/// a path attains the lower bound on `U_max` all the same.
+pub const END_ENERGY_ROUNDING: f64 = 1e-12;
+
+/// Whether `top`, the largest energy along a path, is `ends`, its larger end energy, to
+/// [`END_ENERGY_ROUNDING`]: the path then attains the lower bound on every path's `U_max`.
+pub fn attains_end_energy(top: f64, ends: f64) -> bool {
+    top <= ends + END_ENERGY_ROUNDING * ends.abs().max(top.abs())
 }
 
 /// A shape's points in case units and, per obstacle, every point's surface gap `d − r`.
