@@ -15,6 +15,11 @@ use super::verify::Verification;
 use super::{Judged, Planner};
 use crate::constraints::Constraint;
 
+/// Largest difference of any coefficient (angles in radians, strains) between the start and
+/// goal shapes for which the straight-line path counts as holding one shape: a goal solved at
+/// the start's own pose lands on its shape to the last bits.
+const STATIONARY: f64 = 1e-12;
+
 impl Planner {
     /// Whether the straight path `straight` (its verification) attains the lower bound on
     /// `U_max` and keeps the optimiser's clearances, so that it is worth replaying as the plan:
@@ -25,9 +30,15 @@ impl Planner {
     pub(super) fn straight_path_attains_bound(&self, straight: &Verification) -> bool {
         let l = self.base.model.rod.length;
         let at_end = straight.peaks_at_an_end();
-        let clear = straight
-            .min_clearance
-            .is_none_or(|c| c >= self.safety() * l)
+        // A path that holds one shape throughout (a goal at the start's own pose, solved to the
+        // same shape) moves nothing: its clearance is that end shape's, which may rest on an
+        // obstacle, and needs no safety margin.
+        let clearance = if self.is_stationary() {
+            -self.collision_tolerance()
+        } else {
+            self.safety() * l
+        };
+        let clear = straight.min_clearance.is_none_or(|c| c >= clearance)
             && straight
                 .self_contact
                 .is_none_or(|(g, _)| g >= -self.collision_tolerance());
@@ -43,6 +54,18 @@ impl Planner {
             | Constraint::SelfContact(_) => true,
         });
         self.settings.straight_path_first && at_end && clear && only_contacts
+    }
+
+    /// Whether the start and goal shapes are the same, to [`STATIONARY`] in every coefficient:
+    /// the straight-line path then holds that shape at every `k`.
+    fn is_stationary(&self) -> bool {
+        self.start.a.len() == self.goal.a.len()
+            && self
+                .start
+                .a
+                .iter()
+                .zip(&self.goal.a)
+                .all(|(a, b)| (a - b).abs() <= STATIONARY)
     }
 
     /// The straight path judged as the plan when it attains the lower bound

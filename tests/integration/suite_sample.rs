@@ -778,3 +778,39 @@ fn a_refused_pose_says_where_the_solve_searched() {
     assert!(err.contains("three starting penalties"), "{err}");
     assert!(err.contains("a `shape` near it given to this end"), "{err}");
 }
+
+/// The suite's planar problems `planar_6_20` and `planar_3_35`, whose start shapes rest on an
+/// obstacle (the second on the chords between its contact points), with the goal set to the
+/// start's own pose: the plan is the straight-line path, which holds the start shape at every
+/// `k` and moves nothing, although its clearance (the resting shape's: 9.7e-10 L, and 3.7e-4 L
+/// held off on the chords) is below the safety margin that a moving path keeps (L/100). (Before, the optimiser
+/// took the end 1.27 L away and back with 2.9 rad of turning, and the first one's optimal path
+/// collided.)
+#[test]
+fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
+    use dlo_planner::planner::observer::Silent;
+    for (seed, index) in [(6, 20), (3, 35)] {
+        let name = format!("planar_{seed}_{index}");
+        let (text, _) = planar_planner(seed, index);
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["plan"]["goal"] = v["plan"]["start"].clone();
+        let c = dlo_planner::case::parse(&v.to_string(), std::path::Path::new("still.json"))
+            .expect("a generated case");
+        let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+        let l = p.base.model.rod.length;
+        let r = p.run(&mut Silent);
+        let clearance = r.min_clearance_straight.expect("obstacles");
+        // Inside the default safety margin (L/100), and clear.
+        assert!(
+            (-1e-6 * l..1e-3 * l).contains(&clearance),
+            "{name}: the start does not rest on an obstacle ({clearance})"
+        );
+        assert!(r.straight_path_plan && r.starts.is_empty(), "{name}");
+        assert_eq!(r.executed_path(), Some("optimal"), "{name}");
+        assert!(
+            r.trajectory.path_length <= 1e-12 * l,
+            "{name}: the end travels {}",
+            r.trajectory.path_length
+        );
+    }
+}
