@@ -1162,6 +1162,8 @@ impl Planner {
         // straight path when it already attains the lower bound and executes as it stands;
         // else the starts.
         let end_inside = self.end_inside_obstacle(&fine);
+        // The plan is the equilibria along the straight path's trajectory.
+        let mut along_straight = false;
         let (runs, best, mut judged) = if end_inside.is_some() {
             (
                 Vec::new(),
@@ -1171,10 +1173,16 @@ impl Planner {
         } else {
             match self.straight_path_plan(&straight, observer) {
                 Some(j) => (Vec::new(), None, j),
-                None => {
-                    let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
-                    (runs, Some(best), judged)
-                }
+                None => match self.straight_trajectory_plan(&straight, &fine, observer) {
+                    Some(j) => {
+                        along_straight = true;
+                        (Vec::new(), None, j)
+                    }
+                    None => {
+                        let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
+                        (runs, Some(best), judged)
+                    }
+                },
             }
         };
         observer.phase("select");
@@ -1200,7 +1208,6 @@ impl Planner {
         // them), as the plan if they pass.
         let straight_path = self.path();
         let straight_z = vec![0.0; straight_path.n_vars()];
-        let mut along_straight = false;
         if !judged.executable
             && end_inside.is_none()
             && judged.replay.start_held()

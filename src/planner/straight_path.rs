@@ -11,7 +11,7 @@
 
 use super::observer::{PlanObserver, Recorder};
 use super::replay::EarlyStop;
-use super::verify::Verification;
+use super::verify::{Verification, attains_end_energy, shape_worst_clearance};
 use super::{Judged, Planner};
 use crate::constraints::Constraint;
 
@@ -66,6 +66,54 @@ impl Planner {
                 .iter()
                 .zip(&self.goal.a)
                 .all(|(a, b)| (a - b).abs() <= STATIONARY)
+    }
+
+    /// Where an end shape rests on an obstacle (closer to it than the safety margin, which no
+    /// path can then keep next to that end) and the straight path peaks at an end shape but
+    /// does not keep the margin: the equilibria along the straight path's trajectory (the end
+    /// moved through the straight path's end poses, the rod sliding over the obstacle), judged
+    /// as the plan when they are executable and attain the lower bound on `U_max` themselves.
+    /// No path is lower, and the gripper's path is the straight path's. `None` otherwise (the
+    /// replay's shapes are then dropped, not logged).
+    pub(super) fn straight_trajectory_plan(
+        &self,
+        straight: &Verification,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Option<Judged> {
+        let s = &self.settings;
+        if !(s.straight_path_first && s.equilibrium_plans && straight.peaks_at_an_end())
+            || self.stopped()
+        {
+            return None;
+        }
+        let margin = self.safety() * self.base.model.rod.length;
+        let rests = [&self.start.a, &self.goal.a].into_iter().any(|a| {
+            shape_worst_clearance(fine, &self.obstacles, a).is_some_and(|w| w.clearance < margin)
+        });
+        if !rests {
+            return None;
+        }
+        let path = self.path();
+        let z = vec![0.0; path.n_vars()];
+        let mut judged = self.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        let bound = self
+            .start
+            .energy
+            .internal()
+            .max(self.goal.energy.internal());
+        let e = judged.equilibrium_plan.as_mut()?;
+        let near = bound + self.settings.energy_gap_tolerance * bound.abs();
+        if !(judged.executable && (attains_end_energy(e.u_max, bound) || e.u_max <= near)) {
+            return None;
+        }
+        e.trajectory = "straight_path";
+        e.optimal_path_not_executable = Some(
+            "the straight-line path comes within the safety margin of an obstacle an end shape \
+             rests on; the optimiser did not run"
+                .into(),
+        );
+        Some(judged)
     }
 
     /// The straight path judged as the plan when it attains the lower bound

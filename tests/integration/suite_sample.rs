@@ -814,3 +814,50 @@ fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
         );
     }
 }
+
+/// The suite's planar problem `planar_6_20`, whose start shape rests on an obstacle, with the
+/// goal 0.01 L and 0.05 L along x from the start's pose: a small move no path can make while
+/// keeping the safety margin next to the start (the straight-line path dips 2.2e-4 L into the
+/// obstacle between the resting shapes). The plan is the equilibria along the straight-line
+/// path's trajectory, the rod sliding over the obstacle: executable, peaking within the
+/// energy-gap tolerance (1 %) of the lower bound on U_max, the larger end energy, and the
+/// gripper's path within 1 % of the straight-line distance. (Before, the optimiser ran, did
+/// not converge, and the plan, its path's replayed equilibria, took the end 1.93 L and 2.09 L
+/// round, with 2.9 and 2.7 rad of turning, to peak no lower.)
+#[test]
+fn a_small_move_from_a_resting_start_slides_along_the_straight_trajectory() {
+    use dlo_planner::planner::observer::Silent;
+    for dx in [0.01, 0.05] {
+        let (text, _) = planar_planner(6, 20);
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let x = v["plan"]["start"]["x"].as_f64().unwrap();
+        v["plan"]["goal"] = v["plan"]["start"].clone();
+        v["plan"]["goal"]["x"] = (x + dx).into();
+        let c = dlo_planner::case::parse(&v.to_string(), std::path::Path::new("slide.json"))
+            .expect("a generated case");
+        let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+        let l = p.base.model.rod.length;
+        let r = p.run(&mut Silent);
+        assert!(r.verdict().is_executable(), "{dx}: {}", r.verdict());
+        assert!(r.optimiser.is_none() && r.starts.is_empty(), "{dx}");
+        let e = r
+            .equilibrium_plan
+            .as_ref()
+            .expect("the equilibria are the plan");
+        assert_eq!(e.trajectory, "straight_path", "{dx}");
+        let bound = p.start.energy.internal().max(p.goal.energy.internal());
+        assert!(e.u_max <= 1.01 * bound, "{dx}: {} against {bound}", e.u_max);
+        let t = &r.trajectory;
+        // The end shapes hold their poses to the static solves' feasibility.
+        assert!(
+            (t.straight_distance - dx).abs() <= 1e-8 * l,
+            "{dx}: {}",
+            t.straight_distance
+        );
+        assert!(
+            t.path_length <= 1.01 * t.straight_distance,
+            "{dx}: the end travels {}",
+            t.path_length
+        );
+    }
+}
