@@ -109,10 +109,10 @@ def test_a_callback_stops_a_plan_and_its_log_is_finished(log_dir):
         dlo.plan(held, start, goal, progress=lambda e, info: 1 / 0)
 
 
-def test_two_threads_plan_at_once_faster_than_one_after_the_other():
+def test_a_plan_releases_the_gil_and_two_at_once_equal_one_after_the_other():
     held, start, goal = block_problem()
     # One thread per plan: with the default, one plan already keeps both cores of a 2-core
-    # machine busy part of the time, and this test measures the GIL, not that.
+    # machine busy part of the time, and this test is about the GIL, not that.
     settings = {"starts": 1, "threads": 1}
     reference = dlo.plan(held, start, goal, settings=settings)
 
@@ -126,39 +126,20 @@ def test_two_threads_plan_at_once_faster_than_one_after_the_other():
     worker.join()
     assert spins > 100_000
 
-    def serial():
-        return [dlo.plan(held, start, goal, settings=settings) for _ in range(2)]
+    # Two plans in two threads at once give what two plans one after the other give. (How
+    # much faster they are on two cores is measured by python/benches/two_threads.py.)
+    results = [None, None]
 
-    def threaded():
-        results = [None, None]
+    def work(i):
+        results[i] = dlo.plan(held, start, goal, settings=settings)
 
-        def work(i):
-            results[i] = dlo.plan(held, start, goal, settings=settings)
-
-        threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-        return results
-
-    def timed(run):
-        t0 = time.perf_counter()
-        out = run()
-        return time.perf_counter() - t0, out
-
-    # The two ways take turns, three times each, so that both meet the machine's speed of the
-    # moment alike; the fastest run of each counts.
-    t_serial = t_threads = float("inf")
-    for _ in range(3):
-        t, one_after_other = timed(serial)
-        t_serial = min(t_serial, t)
-        t, at_once = timed(threaded)
-        t_threads = min(t_threads, t)
-    assert [r.u_max for r in at_once] == [r.u_max for r in one_after_other] == [reference.u_max] * 2
-    # With the GIL held they would take as long as one after the other; released, the two
-    # cores share them (ideally half the time).
-    assert t_threads < 0.8 * t_serial, (t_threads, t_serial)
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    one_after_other = [dlo.plan(held, start, goal, settings=settings) for _ in range(2)]
+    assert [r.u_max for r in results] == [r.u_max for r in one_after_other] == [reference.u_max] * 2
 
 
 def test_ctrl_c_stops_a_plan_and_finishes_its_log(log_dir):
