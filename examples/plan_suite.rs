@@ -285,7 +285,11 @@ fn problem_case(
     for (key, value) in top.as_object().into_iter().flatten() {
         v[key] = value.clone();
     }
-    let path = Path::new("planning_cases").join(format!("{name}.json"));
+    // The case's folder in this crate, wherever the runner is started from: the 3D problems'
+    // mesh (`meshes/cube.obj`) is read relative to it.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("planning_cases")
+        .join(format!("{name}.json"));
     case::parse(&v.to_string(), &path).ok()
 }
 
