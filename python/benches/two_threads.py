@@ -3,27 +3,24 @@ plan releases the GIL, so on two cores the threads share the work.
 
     python python/benches/two_threads.py [--rounds 5]
 
-The plan is the README's, built in code (a strip under a block, swung from side to side), with
-one thread of its own per plan (`threads: 1`), so that one plan alone keeps one core busy.
-The two ways take turns, `--rounds` times each; the fastest run of each counts.
+The plan is the README's, built in code as `python/tests/test_plan.py` builds it (a strip under
+a block, swung from side to side; the bench imports it from there, with pytest installed), with
+one thread of its own per plan (`threads: 1`), so that one plan alone keeps one core busy. The
+two ways take turns, `--rounds` times each; the fastest run of each counts.
 """
 
 import argparse
 import math
+import sys
 import threading
 import time
+from pathlib import Path
 
 import dlo_planner as dlo
 
-
-def block_problem() -> tuple:
-    rod = dlo.Rod(length=1.0, flexural_rigidity=1.0, radius=0.005)
-    block = dlo.Obstacle.cuboid("block", [0.1, 0.5, 0.25], position=[0.0, 0.0, 1.1])
-    held = dlo.StaticProblem(rod).clamp(0.0, [0, 0, 0], [0.0]).obstacle(block)
-    turn = lambda t: [[math.cos(t), 0, math.sin(t)], [0, 1, 0], [-math.sin(t), 0, math.cos(t)]]  # noqa: E731
-    start = dlo.End.pose([0.5, 0.0, 0.6], rotation=turn(math.pi / 2))
-    goal = dlo.End.pose([-0.5, 0.0, 0.6], rotation=turn(-math.pi / 2))
-    return held, start, goal
+# The plan of the package's tests (`block_problem`), so that both use one problem.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from test_plan import block_problem  # noqa: E402
 
 
 def main() -> None:
