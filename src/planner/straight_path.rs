@@ -72,9 +72,10 @@ impl Planner {
     /// path can then keep next to that end) and the straight path peaks at an end shape but
     /// does not keep the margin: the equilibria along the straight path's trajectory (the end
     /// moved through the straight path's end poses, the rod sliding over the obstacle), judged
-    /// as the plan when they are executable and attain the lower bound on `U_max` themselves.
-    /// No path is lower, and the gripper's path is the straight path's. `None` otherwise (the
-    /// replay's shapes are then dropped, not logged).
+    /// as the plan when they are executable and peak within `energy_gap_tolerance` of the lower
+    /// bound on `U_max` (the larger end energy): no path peaks lower by more than that, and the
+    /// gripper follows the straight path's end poses. `None` otherwise (the replay's shapes are
+    /// then dropped, not logged).
     pub(super) fn straight_trajectory_plan(
         &self,
         straight: &Verification,
