@@ -460,6 +460,13 @@ fn main() {
             i += 1;
             if let Some(dir) = &write_dir {
                 std::fs::create_dir_all(dir).expect("--write: a directory");
+                // The mesh by its path in this crate, so that `dlo plan` finds it from there:
+                // `"meshes/` becomes the folder's path as a JSON string, without its closing
+                // quote (the file name and the quote follow).
+                let meshes = Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases/meshes/");
+                let quoted = format!("{:?}", meshes.display().to_string());
+                let open = &quoted[..quoted.len() - 1];
+                let text = text.replace(r#""obj": "meshes/"#, &format!(r#""obj": {open}"#));
                 std::fs::write(dir.join(format!("{name}.json")), &text).expect("--write: writable");
             }
             if only.is_some_and(|o| o != kind) {
