@@ -783,9 +783,9 @@ fn a_refused_pose_says_where_the_solve_searched() {
 /// obstacle (the second on the chords between its contact points), with the goal set to the
 /// start's own pose: the plan is the straight-line path, which holds the start shape at every
 /// `k` and moves nothing, although its clearance (the resting shape's: 9.7e-10 L, and 3.7e-4 L
-/// held off on the chords) is below the safety margin that a moving path keeps (L/100). (Before, the optimiser
-/// took the end 1.27 L away and back with 2.9 rad of turning, and the first one's optimal path
-/// collided.)
+/// held off on the chords) is below the safety margin that a moving path keeps (L/100).
+/// (Before, the optimiser took the end 1.27 L away and back with 2.9 rad of turning, and the
+/// first one's optimal path collided.)
 #[test]
 fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
     use dlo_planner::planner::observer::Silent;
@@ -823,7 +823,7 @@ fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
 /// energy-gap tolerance (1 %) of the lower bound on U_max, the larger end energy, and the
 /// gripper's path within 1 % of the straight-line distance. (Before, the optimiser ran, did
 /// not converge, and the plan, its path's replayed equilibria, took the end 1.93 L and 2.09 L
-/// round, with 2.9 and 2.7 rad of turning, to peak no lower.)
+/// round, with 2.9 and 2.7 rad of turning, to peak at most 0.04 % lower.)
 #[test]
 fn a_small_move_from_a_resting_start_slides_along_the_straight_trajectory() {
     use dlo_planner::planner::observer::Silent;
