@@ -876,11 +876,9 @@ impl Planner {
         self.settings.safety(self.base.model.rod.length)
     }
 
-    /// The deepest place where the start or the goal shape lies inside an obstacle on the
-    /// verification grid (`fine`), deeper than the collision tolerance: an end the static
-    /// solve holds clear only at its contact points (see [`on_chords_if_dipping`]).
-    fn end_inside_obstacle(&self, fine: &crate::rod::model::Model) -> Option<EndInside> {
-        let tol = self.collision_tolerance();
+    /// The start and the goal shape's worst clearances to the obstacles on the verification
+    /// grid (`fine`), whatever their sign (none without obstacles).
+    fn end_clearances(&self, fine: &crate::rod::model::Model) -> Vec<EndInside> {
         [("start", &self.start), ("goal", &self.goal)]
             .into_iter()
             .filter_map(|(end, sol)| {
@@ -892,8 +890,18 @@ impl Planner {
                     s: w.s,
                 })
             })
+            .collect()
+    }
+
+    /// The deepest place among the end shapes' clearances `ends` ([`Self::end_clearances`])
+    /// where one lies inside an obstacle, deeper than the collision tolerance: an end the
+    /// static solve holds clear only at its contact points (see [`on_chords_if_dipping`]).
+    fn end_inside_obstacle(&self, ends: &[EndInside]) -> Option<EndInside> {
+        let tol = self.collision_tolerance();
+        ends.iter()
             .filter(|e| e.clearance < -tol)
             .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
+            .cloned()
     }
 
     /// Depth below which a verified clearance counts as a collision (1e-6 L).
@@ -1161,7 +1169,8 @@ impl Planner {
         // An end inside an obstacle: no path is collision-free, nothing to optimise. Else the
         // straight path when it already attains the lower bound and executes as it stands;
         // else the starts.
-        let end_inside = self.end_inside_obstacle(&fine);
+        let ends = self.end_clearances(&fine);
+        let end_inside = self.end_inside_obstacle(&ends);
         // The plan is the equilibria along the straight path's trajectory.
         let mut along_straight = false;
         let (runs, best, mut judged) = if end_inside.is_some() {
@@ -1173,7 +1182,7 @@ impl Planner {
         } else {
             match self.straight_path_plan(&straight, observer) {
                 Some(j) => (Vec::new(), None, j),
-                None => match self.straight_trajectory_plan(&straight, &fine, observer) {
+                None => match self.straight_trajectory_plan(&straight, &ends, &fine, observer) {
                     Some(j) => {
                         along_straight = true;
                         (Vec::new(), None, j)
@@ -1206,26 +1215,13 @@ impl Planner {
         // Nothing executable: the trajectory of the straight-line path's end, with the
         // equilibria the end poses produce (touching obstacles where the straight shapes cross
         // them), as the plan if they pass.
-        let straight_path = self.path();
-        let straight_z = vec![0.0; straight_path.n_vars()];
         if !judged.executable
             && end_inside.is_none()
             && judged.replay.start_held()
             && self.settings.equilibrium_plans
             && !self.stopped()
         {
-            // Only its equilibria can be the plan: its replay ends where a solve fails.
-            let mut s = self.judge_path(
-                &straight_path,
-                &straight_z,
-                false,
-                EarlyStop::Unconverged,
-                &fine,
-                observer,
-            );
-            if let Some(e) = s.equilibrium_plan.as_mut() {
-                e.trajectory = "straight_path";
-            }
+            let mut s = self.judge_straight_trajectory(&fine, observer);
             if s.executable {
                 let why = judged
                     .equilibrium_plan
@@ -1270,6 +1266,8 @@ impl Planner {
         let (rep, equilibrium_plan, judged_workspace) =
             (judged.replay, judged.equilibrium_plan, judged.workspace);
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
+        let straight_path = self.path();
+        let straight_z = vec![0.0; straight_path.n_vars()];
         let (traj_path, traj_z) = if along_straight {
             (&straight_path, &straight_z)
         } else {

@@ -262,17 +262,24 @@ impl PlanResult {
             return None;
         }
         // Along the straight-line path's trajectory, the replay is that path's.
-        let straight = self
-            .equilibrium_plan
-            .as_ref()
-            .is_some_and(|e| e.trajectory == "straight_path");
-        if self.status == PlanStatus::Planned && self.replay.coincide && !straight {
+        if self.status == PlanStatus::Planned
+            && self.replay.coincide
+            && !self.along_straight_trajectory()
+        {
             Some("optimal")
         } else if self.equilibrium_plan.as_ref().is_some_and(|e| e.executable) {
             Some("equilibria")
         } else {
             None
         }
+    }
+
+    /// Whether the replayed equilibria judged as the plan follow the straight-line path's end
+    /// poses (`equilibrium_plan.trajectory` is `"straight_path"`).
+    pub fn along_straight_trajectory(&self) -> bool {
+        self.equilibrium_plan
+            .as_ref()
+            .is_some_and(|e| e.trajectory == "straight_path")
     }
 
     /// The verdict: executable, or why not.

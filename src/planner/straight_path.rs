@@ -11,7 +11,8 @@
 
 use super::observer::{PlanObserver, Recorder};
 use super::replay::EarlyStop;
-use super::verify::{Verification, attains_end_energy, shape_worst_clearance};
+use super::result::EndInside;
+use super::verify::{Verification, attains_end_energy};
 use super::{Judged, Planner};
 use crate::constraints::Constraint;
 
@@ -79,6 +80,7 @@ impl Planner {
     pub(super) fn straight_trajectory_plan(
         &self,
         straight: &Verification,
+        ends: &[EndInside],
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> Option<Judged> {
@@ -88,16 +90,12 @@ impl Planner {
         {
             return None;
         }
+        // The end shapes' clearances ([`Planner::end_clearances`]).
         let margin = self.safety() * self.base.model.rod.length;
-        let rests = [&self.start.a, &self.goal.a].into_iter().any(|a| {
-            shape_worst_clearance(fine, &self.obstacles, a).is_some_and(|w| w.clearance < margin)
-        });
-        if !rests {
+        if !ends.iter().any(|e| e.clearance < margin) {
             return None;
         }
-        let path = self.path();
-        let z = vec![0.0; path.n_vars()];
-        let mut judged = self.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        let mut judged = self.judge_straight_trajectory(fine, observer);
         let bound = self
             .start
             .energy
@@ -108,13 +106,29 @@ impl Planner {
         if !(judged.executable && (attains_end_energy(e.u_max, bound) || e.u_max <= near)) {
             return None;
         }
-        e.trajectory = "straight_path";
         e.optimal_path_not_executable = Some(
             "the straight-line path comes within the safety margin of an obstacle an end shape \
              rests on; the optimiser did not run"
                 .into(),
         );
         Some(judged)
+    }
+
+    /// The equilibria along the straight path's trajectory judged as the plan
+    /// ([`Self::judge_path`] with `trajectory` `"straight_path"`): only its equilibria can be
+    /// the plan, so its replay ends where a solve fails.
+    pub(super) fn judge_straight_trajectory(
+        &self,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let path = self.path();
+        let z = vec![0.0; path.n_vars()];
+        let mut judged = self.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        if let Some(e) = judged.equilibrium_plan.as_mut() {
+            e.trajectory = "straight_path";
+        }
+        judged
     }
 
     /// The straight path judged as the plan when it attains the lower bound

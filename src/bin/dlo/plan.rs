@@ -323,10 +323,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         r.case,
         r.verdict,
         match r.executed_path {
-            Some("equilibria")
-                if p.equilibrium_plan
-                    .as_ref()
-                    .is_some_and(|e| e.trajectory == "straight_path") =>
+            Some("equilibria") if p.along_straight_trajectory() =>
                 " by the replayed equilibria along the straight-line path's trajectory",
             Some("equilibria") => " by the replayed equilibria along the optimal path's trajectory",
             Some(_) if p.straight_path_plan => " along the straight-line path",
@@ -340,11 +337,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 "optimiser not run: the {} shape lies inside obstacle {}, so no path is collision-free",
                 e.end, e.obstacle
             ),
-            (None, None)
-                if p.equilibrium_plan
-                    .as_ref()
-                    .is_some_and(|e| e.trajectory == "straight_path") =>
-            {
+            (None, None) if p.along_straight_trajectory() => {
                 "optimiser not run: an end shape rests on an obstacle, and the equilibria along the straight-line path's trajectory peak within the energy-gap tolerance of the lower bound on U_max".into()
             }
             (None, None) => "optimiser not run: the straight-line path attains the lower bound on U_max, the larger end energy".into(),
