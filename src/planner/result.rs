@@ -108,8 +108,8 @@ pub enum Attempt {
     Fallback,
     /// The case's path terms without the travel term (the paper's objective).
     WithoutTravel,
-    /// A plan of the quick attempt or the case's own that attains the lower bound on `U_max`
-    /// and is collision-free but not executable, lifted to the first fallback count's path
+    /// A converged plan, collision-free but not executable (the quick attempt's where it
+    /// attains the lower bound on `U_max`, or the case's own), lifted to the first fallback count's path
     /// terms (the new terms zero, the same path) and tracked again, with no sharpness stage:
     /// tracking pulls the shapes onto their equilibria with the extra terms' freedom. Its
     /// `status` is its tracking's, or its source's where no tracking round ran.

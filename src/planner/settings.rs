@@ -108,10 +108,10 @@ pub struct PlanSettings {
     /// `false`: only the case's own attempt and those after it (no effect on a 3D rod, whose
     /// own stages carry the curvature).
     pub quick_attempt: bool,
-    /// Lift a plan of the quick attempt or the case's own that attains the lower bound on
-    /// `U_max` and is collision-free but not executable to the first fallback count's path
-    /// terms and run equilibrium tracking on it again ([`super::Attempt::Lifted`]), before the
-    /// next attempt, once per search; `false`: never.
+    /// Lift a converged plan that is collision-free but not executable — the quick attempt's
+    /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the
+    /// first fallback count's path terms and run equilibrium tracking on it again
+    /// ([`super::Attempt::Lifted`]), before the next attempt, once per search; `false`: never.
     pub lift: bool,
     /// Wall-clock seconds the search may take, counted from the start of
     /// [`super::Planner::run`] (the end shapes, solved when the planner is made, are not

@@ -6,9 +6,9 @@
 //! group (the best not replayed yet) is executable (its replay coincides with it, or its
 //! replayed equilibria are a plan; after the quick attempt, only one that attains the lower
 //! bound on `U_max` ends the search); and which of the plans is the plan. Where the quick
-//! attempt's or the case's own plan attains that bound and is collision-free but not
-//! executable, the same path with the first fallback count's path terms is tracked again
-//! before the next attempt ([`Attempt::Lifted`], once per search). Unless the case sets
+//! attempt's plan attains that bound, or the case's own plan converged, and it is
+//! collision-free but not executable, the same path with the first fallback count's path
+//! terms is tracked again before the next attempt ([`Attempt::Lifted`], once per search). Unless the case sets
 //! `swept_clearance`, the attempts after one whose plans all tunnel through an obstacle (other
 //! than the quick attempt) hold the swept rows.
 
@@ -357,8 +357,8 @@ impl Planner {
     }
 
     /// The lift of the best of `group`'s plans (an attempt of kind `kind`) when it is
-    /// collision-free, converged, settled and peaks at an end shape on the verification grid,
-    /// and the first fallback count has more path terms than it.
+    /// collision-free, converged and settled, a quick plan peaks at an end shape on the
+    /// verification grid, and the first fallback count has more path terms than it.
     fn lift(&self, group: &[StartPlan], kind: Attempt) -> Option<Lift> {
         if !matches!(kind, Attempt::Quick | Attempt::Own) || !self.settings.lift {
             return None;
@@ -374,7 +374,7 @@ impl Planner {
             && v.run.settled
             && v.run.status == crate::optim::AlStatus::Converged
             && v.verification.collision_free(self.collision_tolerance())
-            && v.verification.peaks_at_an_end();
+            && (kind == Attempt::Own || v.verification.peaks_at_an_end());
         if !liftable {
             return None;
         }

@@ -221,6 +221,60 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
     );
 }
 
+/// The suite's planar problem `planar_16_60` (seed 16), planned with the defaults: neither
+/// the quick attempt's plan nor the case's own attains the lower bound on U_max (both peak
+/// inside the path), and the own plan, converged and collision-free, lies farther than the
+/// coincidence tolerance from its equilibria (8.6 % of L measured). That path lifted to the
+/// first fallback count's path terms and tracked again coincides with its replay, so it is the
+/// plan and no fallback runs. Checked independently of the planner's grid: on 801 values of k
+/// and 1024 intervals in s the plan's clearance is at least −1e-6 L and its largest energy is
+/// the reported U_max (to 1e-3 relative: the finer grid can only find more of a peak, and
+/// the planner refines its samples until it misses none by more than `energy_gap_tolerance`);
+/// without the lift (`"lift": false`) the search runs the first fallback and finds no lower
+/// U_max.
+#[test]
+fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
+    use dlo_planner::planner::Attempt;
+    let (p, r) = suite_planar_plan_of(16, 60);
+    let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
+    let (own, lifted) = (&r.starts[1], &r.starts[2]);
+    let tol = r.replay.tolerance;
+    assert!(own.collision_free);
+    assert_eq!(own.status, dlo_planner::optim::AlStatus::Converged);
+    assert!(own.equilibrium_deviation.expect("tracked") > tol, "{own:?}");
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
+    let ends = v.energies[0].max(*v.energies.last().expect("a grid"));
+    assert!(v.u_max > ends * 1.01, "{} vs {ends}", v.u_max);
+    assert!(
+        (v.u_max - r.u_max).abs() <= 1e-3 * r.u_max,
+        "{} vs {}",
+        v.u_max,
+        r.u_max
+    );
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    assert_eq!(r.chosen_start, Some(lifted.start));
+    let terms = p.settings.fallback_terms(false)[0];
+    assert_eq!((lifted.path_terms, r.path_terms), (terms, terms));
+    assert_eq!(r.executed_path(), Some("optimal"));
+    assert!(r.replay.coincide && r.replay.max_deviation_over_l <= tol);
+    let (_, unlifted) = suite_planar_plan_with(16, 60, serde_json::json!({ "lift": false }));
+    assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
+    assert!(
+        unlifted
+            .starts
+            .iter()
+            .any(|s| s.attempt == Attempt::Fallback)
+    );
+    assert!(
+        unlifted.u_max >= r.u_max * (1.0 - 1e-9),
+        "{} vs {}",
+        unlifted.u_max,
+        r.u_max
+    );
+}
+
 /// The suite's planar problem `planar_1_11` (seed 1), planned with the defaults: its optimal
 /// path is collision-free but its replay departs by 4.9 % of L, so the plan the gripper
 /// executes is the replayed equilibria along the optimal path's trajectory. Checked
