@@ -9,6 +9,7 @@ mod cli_errors;
 mod common;
 mod contacts;
 mod elastica;
+mod failure_advice;
 mod golden;
 mod gradients;
 mod grasp;

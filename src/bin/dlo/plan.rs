@@ -169,7 +169,7 @@ pub(crate) fn run_plan(
                 "error: {}: no collision-free plan: the verification grid finds the rod crossing itself (gap {gap:.3e} at k = {k:.3}){}; {}",
                 path.display(),
                 time_limit_note(&result),
-                TRY_COLLISION
+                what_to_try(&planner, Failure::Collision)
             );
             ExitCode::from(EXIT_COLLISION)
         }
@@ -200,7 +200,7 @@ pub(crate) fn run_plan(
                 worst.map_or(0.0, |o| o.k),
                 worst.map_or(0.0, |o| o.s),
                 equilibria_not_a_plan(&result),
-                TRY_COLLISION
+                what_to_try(&planner, Failure::Collision)
             );
             ExitCode::from(EXIT_COLLISION)
         }
@@ -216,11 +216,12 @@ pub(crate) fn run_plan(
         }
         PlanVerdict::NotConverged => {
             eprintln!(
-                "error: {}: the path optimiser did not converge ({}, violation {:.2e}){}",
+                "error: {}: the path optimiser did not converge ({}, violation {:.2e}){}; {}",
                 path.display(),
                 result.optimiser.map_or("not run".into(), |o| o.to_string()),
                 result.violation,
-                equilibria_not_a_plan(&result)
+                equilibria_not_a_plan(&result),
+                what_to_try(&planner, Failure::NotConverged)
             );
             ExitCode::from(EXIT_NOT_CONVERGED)
         }
@@ -238,7 +239,7 @@ pub(crate) fn run_plan(
                 },
                 equilibria_not_a_plan(&result),
                 if result.replay.start_held() {
-                    TRY_DEPARTURE.to_string()
+                    what_to_try(&planner, Failure::Departure)
                 } else if start_written {
                     format!(
                         "the start shape is not held by its end pose (not a stable equilibrium there): the replay leaves it by {:.3} L at k = 0, so no path from it can be executed by the controlled end; start from the pose alone (plan.start without `shape`) or from a shape the pose holds",
@@ -281,8 +282,97 @@ fn unreachable_end(c: &Case, json: bool, end: &str, message: &str) -> ExitCode {
     ExitCode::from(EXIT_UNREACHABLE)
 }
 
-/// What to try when no plan is collision-free (the case file's `plan` fields).
-pub(crate) const TRY_COLLISION: &str = "try plan.swept_clearance: true, more plan.k_samples, more path terms (plan.fallback_path_terms, e.g. [6, 8]) or more plan.starts";
+/// Which kind of failure [`what_to_try`] advises on.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Failure {
+    /// No plan is collision-free on the verification grid.
+    Collision,
+    /// The replay by the controlled end departs from the plan, or snaps through.
+    Departure,
+    /// The path optimiser did not converge.
+    NotConverged,
+}
+
+/// What to try after `failure`, in the case file's `plan` fields, with values beyond what
+/// `planner` already ran (its settings as the case and the defaults made them).
+pub(crate) fn what_to_try(planner: &Planner, failure: Failure) -> String {
+    let s = &planner.settings;
+    let spatial = planner.base.model.layout.spatial;
+    let mut terms = s.fallback_terms(spatial);
+    let largest = terms.iter().copied().max().unwrap_or(s.path_terms);
+    terms.push(if terms.is_empty() {
+        s.path_terms.max(4) + 2
+    } else {
+        largest + 4
+    });
+    if terms.len() == 1 {
+        terms.push(terms[0] + 2);
+    }
+    let terms = format!(
+        "more path terms (plan.fallback_path_terms: [{}])",
+        terms
+            .iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let starts = format!(
+        "more starts (plan.starts: {}, now {})",
+        (2 * s.starts).max(4),
+        s.starts
+    );
+    let mut tries = Vec::new();
+    match failure {
+        Failure::Collision => {
+            if !s.swept() {
+                tries.push("plan.swept_clearance: true".to_string());
+            }
+            tries.push(format!(
+                "more samples of k (plan.k_samples: {}, now {})",
+                2 * s.k_samples - 1,
+                s.k_samples
+            ));
+            tries.push(terms);
+            tries.push(starts);
+        }
+        Failure::Departure => {
+            tries.push(terms);
+            tries.push(starts);
+            let w = s.tracking_weight(spatial);
+            tries.push(if w > 0.0 {
+                format!(
+                    "stronger equilibrium tracking (plan.equilibrium_weight: {:e}, now {w:e})",
+                    10.0 * w
+                )
+            } else {
+                "equilibrium tracking (plan.equilibrium_weight: 1e4, now off)".to_string()
+            });
+        }
+        Failure::NotConverged => {
+            tries.push(starts);
+            tries.push(terms);
+            tries.push(format!(
+                "a larger budget for the attempts after the case's own (plan.fallback_evaluations: {}, now {})",
+                2 * s.fallback_evaluations,
+                s.fallback_evaluations
+            ));
+        }
+    }
+    let last = tries.pop().expect("at least one");
+    let tried = if tries.is_empty() {
+        last
+    } else {
+        format!("{} or {last}", tries.join(", "))
+    };
+    match failure {
+        Failure::Departure => {
+            format!("try {tried}; the replayed path in the log is what the controlled end does")
+        }
+        _ => format!(
+            "try {tried}; or plan in two legs through a pose between the start and the goal"
+        ),
+    }
+}
 
 /// What to try when an end shape lies inside an obstacle between its contact points.
 pub(crate) const TRY_END_INSIDE: &str =
@@ -309,9 +399,6 @@ fn time_limit_note(result: &dlo_planner::planner::PlanResult) -> &'static str {
         ""
     }
 }
-
-/// What to try when the replay departs from the plan.
-pub(crate) const TRY_DEPARTURE: &str = "try more path terms (plan.fallback_path_terms, e.g. [6, 8]), more plan.starts, or a stronger plan.equilibrium_weight; the replayed path in the log is what the controlled end does";
 
 pub(crate) fn plan_summary(r: &PlanReport) -> String {
     use std::fmt::Write;
