@@ -58,8 +58,8 @@ fn after_quick(
 }
 
 /// The attempts after the case's own have an evaluation budget (so has the quick attempt before
-/// it): on the paper's case with its three path terms (whose first start does not coincide)
-/// and no equilibrium plans, the
+/// it): on the paper's case with its three path terms (whose first start does not coincide),
+/// no equilibrium plans and no lift of the own plan (which would run before the fallback), the
 /// six-term fallback stops its sharpness stages once it has used `fallback_evaluations` (checked
 /// between stages, so it may exceed it by one stage: with a budget of 100 it runs its first
 /// stage only), says `iteration_limit`, and its plan is still verified and reported; without
@@ -80,7 +80,7 @@ fn fallback_attempts_stop_at_their_evaluation_budget() {
         let c = shipped_variant("plan_paper_planar.json", |v| {
             let fields = serde_json::json!({
                 "path_terms": 3, "safety_margin": 0.01, "starts": 1, "fallback_path_terms": [6],
-                "equilibrium_plans": false, "fallback_evaluations": budget
+                "equilibrium_plans": false, "fallback_evaluations": budget, "lift": false
             });
             for (key, val) in fields.as_object().unwrap() {
                 v["plan"][key] = val.clone();
