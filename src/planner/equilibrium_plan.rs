@@ -117,6 +117,21 @@ impl PlanObserver for StopOnly<'_> {
     }
 }
 
+/// Values of `k` for a reader: `[0.015625, 0.01875, 0.025]` (nine decimals, trailing zeros
+/// dropped: the replay's steps and bisections are short binary fractions, which `{:?}` can
+/// print as `0.018750000000000003`).
+pub fn k_list(ks: &[f64]) -> String {
+    let each: Vec<String> = ks
+        .iter()
+        .map(|k| {
+            let t = format!("{k:.9}");
+            let t = t.trim_end_matches('0');
+            t.strip_suffix('.').unwrap_or(t).to_string()
+        })
+        .collect();
+    format!("[{}]", each.join(", "))
+}
+
 /// What keeps a replay's shapes from being a plan, if anything: the first failing check of
 /// [`EquilibriumPlan::executable`] other than the confirmation.
 fn failure(first: &Replay) -> Option<String> {
@@ -128,17 +143,20 @@ fn failure(first: &Replay) -> Option<String> {
     }
     if !first.all_converged {
         return Some(format!(
-            "replay solves did not converge at k = {:?}",
-            ks(&|s| !s.converged)
+            "replay solves did not converge at k = {}",
+            k_list(&ks(&|s| !s.converged))
         ));
     }
     if !first.snaps.is_empty() {
-        return Some(format!("the replay snaps through at k = {:?}", first.snaps));
+        return Some(format!(
+            "the replay snaps through at k = {}",
+            k_list(&first.snaps)
+        ));
     }
     if !first.all_stable {
         return Some(format!(
-            "replayed shapes are unstable at k = {:?}",
-            ks(&|s| s.stable == Some(false))
+            "replayed shapes are unstable at k = {}",
+            k_list(&ks(&|s| s.stable == Some(false)))
         ));
     }
     if first.end_deviation_over_l > first.tolerance {
@@ -206,10 +224,8 @@ impl Planner {
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> EquilibriumPlan {
-        let (iu, u_max) = first
-            .steps
-            .iter()
-            .enumerate()
+        // (Over the equilibria: a solve that did not converge is none.)
+        let (iu, u_max) = super::replay::equilibrium_steps(&first.steps)
             .map(|(i, s)| (i, s.u_feasible))
             .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
         let mut plan = EquilibriumPlan {
@@ -297,5 +313,19 @@ impl Planner {
             });
         plan.executable = plan.reason.is_none();
         plan
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Nine decimals at most, no trailing zeros, and no rounding residue of a sum of steps.
+    #[test]
+    fn k_lists_read_as_short_decimals() {
+        assert_eq!(super::k_list(&[]), "[]");
+        assert_eq!(
+            super::k_list(&[0.015625, 0.018750000000000003, 0.3109375, 0.0, 1.0]),
+            "[0.015625, 0.01875, 0.3109375, 0, 1]"
+        );
+        assert_eq!(super::k_list(&[0.1 + 0.2]), "[0.3]");
     }
 }

@@ -61,7 +61,9 @@ pub struct Replay {
     pub max_deviation_over_l: f64,
     /// `k` of that maximum.
     pub k_at_max_deviation: f64,
-    /// Largest energy along the feasible path (case units).
+    /// Largest energy along the feasible path (case units), over the solves that converged
+    /// (a solve that did not is no equilibrium; over every solve where none converged), as
+    /// are `min_clearance` and `max_contact_force`.
     pub u_max: f64,
     /// Every replayed shape is stable.
     pub all_stable: bool,
@@ -220,6 +222,16 @@ pub(crate) fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The steps whose shapes are equilibria, with their indices: those whose static solve
+/// converged (a solve that did not is no equilibrium), or every step where none did.
+pub fn equilibrium_steps(steps: &[ReplayStep]) -> impl Iterator<Item = (usize, &ReplayStep)> {
+    let any = steps.iter().any(|s| s.converged);
+    steps
+        .iter()
+        .enumerate()
+        .filter(move |(_, s)| s.converged || !any)
+}
+
 /// Replays `path(z)` from `start`, the static solve of its start shape (an equilibrium of
 /// `base` plus the start pose, whose multipliers warm-start the first step).
 #[allow(clippy::too_many_arguments)]
@@ -375,29 +387,30 @@ pub fn replay(
             }
         }
     }
-    // The first step with the largest value of `f` (0 if none is positive).
-    let largest = |f: fn(&ReplayStep) -> f64| {
-        steps
-            .iter()
-            .enumerate()
+    let all_converged = steps.iter().all(|s| s.converged);
+    // The first step with the largest value of `f` (0 if none is positive) among `among`.
+    let largest = |f: fn(&ReplayStep) -> f64,
+                   among: &mut dyn Iterator<Item = (usize, &ReplayStep)>| {
+        among
             .map(|(i, s)| (i, f(s)))
             .fold((0, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc })
     };
-    let (imax, dmax) = largest(|s| s.deviation);
-    let all_converged = steps.iter().all(|s| s.converged);
+    let (imax, dmax) = largest(|s| s.deviation, &mut steps.iter().enumerate());
     let all_stable = steps.iter().all(|s| s.stable != Some(false));
     let max_dev = dmax / l;
-    let (icf, fmax) = largest(|s| s.contact_force);
+    // The energies, clearances and contact forces are those of equilibria.
+    let (icf, fmax) = largest(|s| s.contact_force, &mut equilibrium_steps(&steps));
     Replay {
         max_deviation_over_l: max_dev,
         k_at_max_deviation: steps[imax].k,
-        u_max: steps
-            .iter()
-            .map(|s| s.u_feasible)
+        u_max: equilibrium_steps(&steps)
+            .map(|(_, s)| s.u_feasible)
             .fold(f64::NEG_INFINITY, f64::max),
         all_stable,
         all_converged,
-        min_clearance: steps.iter().filter_map(|s| s.clearance).reduce(f64::min),
+        min_clearance: equilibrium_steps(&steps)
+            .filter_map(|(_, s)| s.clearance)
+            .reduce(f64::min),
         max_contact_force: fmax,
         k_at_max_contact_force: steps[icf].k,
         coincide: !interrupted

@@ -751,17 +751,7 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
 #[test]
 fn a_replay_ends_at_its_first_unconverged_solve() {
     use dlo_planner::planner::replay::EarlyStop;
-    let mut rng = Rng(6);
-    for j in 0..67 {
-        planar_problem(&mut rng, j);
-    }
-    let text = (0..=9)
-        .map(|j| spatial_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
-    let path = std::path::Path::new("planning_cases/spatial_6_9.json");
-    let c = dlo_planner::case::parse(&text, path).expect("a generated case");
-    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    let p = spatial_6_9();
     let run = |early_stop| crate::common::replay_straight_path(&p, early_stop);
     let full = run(EarlyStop::Never);
     let first = full
@@ -786,6 +776,52 @@ fn a_replay_ends_at_its_first_unconverged_solve() {
         );
     }
     assert!(!early.coincide && !early.all_converged);
+}
+
+/// The suite's 3D problem `spatial_6_9` (seed 6), with the defaults.
+fn spatial_6_9() -> dlo_planner::planner::Planner {
+    let mut rng = Rng(6);
+    for j in 0..67 {
+        planar_problem(&mut rng, j);
+    }
+    let text = (0..=9)
+        .map(|j| spatial_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let path = std::path::Path::new("planning_cases/spatial_6_9.json");
+    let c = dlo_planner::case::parse(&text, path).expect("a generated case");
+    dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve")
+}
+
+/// The replay of `spatial_6_9`'s straight-line path, whose solves from k ≈ 0.02 on do not
+/// converge: its largest energy, smallest clearance and largest contact force are those of
+/// the solves that converged (equal to the maxima and minimum over those steps, bit for bit),
+/// not of the shapes the others stopped at, which are no equilibria and press into the
+/// obstacle harder than any converged one.
+#[test]
+fn a_replay_reports_the_energy_and_contacts_of_its_equilibria_only() {
+    use dlo_planner::planner::replay::EarlyStop;
+    let p = spatial_6_9();
+    let r = crate::common::replay_straight_path(&p, EarlyStop::Never);
+    let (converged, not): (Vec<_>, Vec<_>) = r.steps.iter().partition(|s| s.converged);
+    assert!(!converged.is_empty() && !not.is_empty());
+    let u = converged
+        .iter()
+        .map(|s| s.u_feasible)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(r.u_max.to_bits(), u.to_bits());
+    let c = converged
+        .iter()
+        .filter_map(|s| s.clearance)
+        .reduce(f64::min);
+    assert_eq!(r.min_clearance.map(f64::to_bits), c.map(f64::to_bits));
+    let f = converged
+        .iter()
+        .map(|s| s.contact_force)
+        .fold(0.0, f64::max);
+    assert_eq!(r.max_contact_force.to_bits(), f.to_bits());
+    let f_not = not.iter().map(|s| s.contact_force).fold(0.0, f64::max);
+    assert!(f_not > f, "{f_not} vs {f}");
 }
 
 /// The generator's second planar problem (seed 1, `planar_1`): its start pose has a static

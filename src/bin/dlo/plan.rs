@@ -501,12 +501,20 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         );
     }
     let rp = &p.replay;
+    // A solve that did not converge is no equilibrium: its energy, clearance and contact
+    // force are left out.
+    let unconverged = rp.steps.iter().filter(|s| !s.converged).count();
+    let of_equilibria = if unconverged > 0 && unconverged < rp.steps.len() {
+        format!(" (of the converged solves; {unconverged} did not converge)")
+    } else {
+        String::new()
+    };
     if rp.steps.is_empty() {
         let _ = writeln!(o, "  replay: not run");
     } else {
         let _ = writeln!(
             o,
-            "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}; all stable {}; all converged {}; snap-through at k = [{}]",
+            "  replay: max deviation {:.4} L at k = {:.3} (tolerance {} L) -> {}; U_max {:.6e}{of_equilibria}; all stable {}; all converged {}; snap-through at k = {}",
             rp.max_deviation_over_l,
             rp.k_at_max_deviation,
             rp.tolerance,
@@ -530,7 +538,10 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         } else {
             "touches no obstacle".to_string()
         };
-        let _ = writeln!(o, "  replayed path: clearance {c:.4e}; {contact}");
+        let _ = writeln!(
+            o,
+            "  replayed path: clearance {c:.4e}; {contact}{of_equilibria}"
+        );
     }
     if let Some(w) = &p.workspace {
         let _ = writeln!(
@@ -602,11 +613,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     o
 }
 
-/// The `k` of snap-throughs, four decimals each.
+/// The `k` of snap-throughs, in brackets (as the library's reasons list them).
 pub(crate) fn snap_list(snaps: &[f64]) -> String {
-    snaps
-        .iter()
-        .map(|k| format!("{k:.4}"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    dlo_planner::planner::equilibrium_plan::k_list(snaps)
 }
