@@ -2,7 +2,6 @@
 //! `dlo plan` and `dlo margin` run it.
 
 use crate::errors::{case_error, input_error};
-use dlo_planner::planner::Planner;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -115,11 +114,11 @@ impl Case {
     ) -> PyResult<Py<PyAny>> {
         let speeds = crate::plan::speed_limits(max_speed, max_angular_speed)?;
         let t0 = Instant::now();
-        use dlo_planner::case::plan::{plan_problem, setup_error};
+        use dlo_planner::case::plan::{plan_problem, planner, setup_error};
         use dlo_planner::planner::PlanSetupError;
         let (problem, settings) = plan_problem(&self.inner).map_err(case_error)?;
         let planner = py
-            .detach(|| Planner::new(problem, settings))
+            .detach(|| planner(&self.inner, problem, settings))
             .map_err(|e| match e {
                 PlanSetupError::Unreachable { end, message } => {
                     let path = self.inner.path.display();

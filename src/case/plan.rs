@@ -340,9 +340,66 @@ pub fn setup_error(case: &Case, e: crate::planner::PlanSetupError) -> Error {
 
 impl crate::planner::Planner {
     /// Validates the case's `plan` section and solves the start and goal shapes
-    /// ([`plan_problem`], then [`Planner::new`](crate::planner::Planner::new)).
+    /// ([`plan_problem`], then [`planner`]).
     pub fn from_case(case: &Case) -> Result<crate::planner::Planner, Error> {
         let (problem, settings) = plan_problem(case)?;
-        crate::planner::Planner::new(problem, settings).map_err(|e| setup_error(case, e))
+        planner(case, problem, settings).map_err(|e| setup_error(case, e))
     }
+}
+
+/// Times the contact samples may be doubled where an end shape dips between them.
+const CONTACT_DOUBLINGS: u32 = 2;
+
+/// The planner of `case`'s `problem` ([`plan_problem`]) with `settings`
+/// ([`Planner::new`](crate::planner::Planner::new)). Where an end shape dips into an obstacle
+/// between the contact points its solve holds clear, on the verification grid
+/// ([`crate::planner::Planner::end_dip`]: a rod wrapped round an obstacle whose radius is not
+/// much larger than the points' spacing), the case's problem is made again with twice the
+/// contact samples (`discretisation.samples`), and again with four times, within their
+/// limits, its end solves started from the shapes solved before. The first whose end shapes
+/// rest clear on the verification grid is the planner, and says so
+/// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
+/// plan then reports the end inside the obstacle).
+pub fn planner(
+    case: &Case,
+    problem: crate::planner::PlanProblem,
+    settings: PlanSettings,
+) -> Result<crate::planner::Planner, crate::planner::PlanSetupError> {
+    use crate::planner::{ContactRefinement, Planner};
+    let own = Planner::new(problem.clone(), settings.clone())?;
+    let Some(dipped) = own.end_dip(1) else {
+        return Ok(own);
+    };
+    let case_samples = case.builder.sample_count();
+    let most = if case.builder.has_self_contact() {
+        super::limits::MAX_SELF_CONTACT_SAMPLES
+    } else {
+        crate::rod::model::MAX_SAMPLES
+    };
+    let mut seeded = problem;
+    seeded.start.shape = Some(own.start.a.clone());
+    seeded.goal.shape = Some(own.goal.a.clone());
+    for n in (1..=CONTACT_DOUBLINGS).map(|d| case_samples << d) {
+        if n > most {
+            break;
+        }
+        let Ok(statics) = case.builder.clone().samples(n).build() else {
+            break;
+        };
+        seeded.statics = statics;
+        let Ok(mut p) = Planner::new(seeded.clone(), settings.clone()) else {
+            break;
+        };
+        if p.end_dip(1).is_none() {
+            p.contact_refinement = Some(ContactRefinement {
+                case_samples,
+                samples: n,
+                dipped,
+            });
+            return Ok(p);
+        }
+        seeded.start.shape = Some(p.start.a.clone());
+        seeded.goal.shape = Some(p.goal.a.clone());
+    }
+    Ok(own)
 }

@@ -42,7 +42,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
 pub use result::{
-    Attempt, EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict, StartSummary, Timing,
+    Attempt, ContactRefinement, EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict,
+    StartSummary, Timing,
 };
 use start::Verified;
 use starts::StartPlan;
@@ -156,6 +157,10 @@ pub struct Planner {
     /// chords between the sample points, where it needed the chords; `None` where it rests on
     /// its sample points (or touches nothing).
     pub start_contacts: Option<f64>,
+    /// Where the planner was made with more contact samples than its case's, because an end
+    /// shape dipped into an obstacle between the case's (set by
+    /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples`]).
+    pub contact_refinement: Option<ContactRefinement>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
@@ -823,6 +828,7 @@ impl Planner {
         Ok(Planner {
             held,
             start_contacts,
+            contact_refinement: None,
             base: problem.statics,
             obstacles: problem.obstacles,
             static_options,
@@ -891,6 +897,16 @@ impl Planner {
                 })
             })
             .collect()
+    }
+
+    /// The deepest place where an end shape lies inside an obstacle, deeper than the
+    /// collision tolerance, although its static solve holds it clear at the contact points
+    /// (and on their chords, held off, where it dipped between them), on the verification grid
+    /// in s made `finer` times finer (1: the grid itself, on which such an end leaves no path
+    /// collision-free, [`PlanResult::end_inside_obstacle`]).
+    pub fn end_dip(&self, finer: usize) -> Option<EndInside> {
+        let fine = fine_model(&self.base.model, finer * self.settings.verify_s_samples, 4);
+        self.end_inside_obstacle(&self.end_clearances(&fine))
     }
 
     /// The deepest place among the end shapes' clearances `ends` ([`Self::end_clearances`])
@@ -1292,6 +1308,7 @@ impl Planner {
             optimiser,
             straight_path_plan: best.is_none() && end_inside.is_none(),
             end_inside_obstacle: end_inside,
+            contact_samples: self.contact_refinement.clone(),
             u_max: ver.u_max,
             k_at_u_max: ver.k_at_u_max,
             sampled_u_max: chosen.sampled_max,

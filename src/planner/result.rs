@@ -193,6 +193,11 @@ pub struct PlanResult {
     /// collision-free, and the planner does not optimise (`starts` is empty, the replay is not
     /// run, the status is `collision`).
     pub end_inside_obstacle: Option<EndInside>,
+    /// Where the case's contact samples (`discretisation.samples`) let an end shape dip into an
+    /// obstacle between them and the plan was made with more ([`ContactRefinement`]); absent
+    /// otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_samples: Option<ContactRefinement>,
     /// True `U_max` of the plan on the verification grid (case units).
     pub u_max: f64,
     /// `k` where it occurs.
@@ -298,6 +303,18 @@ impl PlanResult {
             PlanStatus::Planned => PlanVerdict::Departs,
         }
     }
+}
+
+/// The contact samples a case's plan was made with where the case's own let an end shape dip
+/// into an obstacle between them ([`PlanResult::contact_samples`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ContactRefinement {
+    /// The case's `discretisation.samples`.
+    pub case_samples: usize,
+    /// The samples the plan was made with (twice or four times the case's).
+    pub samples: usize,
+    /// Where the end shape dipped with the case's samples.
+    pub dipped: EndInside,
 }
 
 /// Where an end shape lies inside an obstacle ([`PlanResult::end_inside_obstacle`]).

@@ -30,6 +30,9 @@ pub struct Discretisation {
     pub gauss_points: usize,
 }
 
+/// Most intervals between the points checked against obstacles and self-contact.
+pub const MAX_SAMPLES: usize = 2000;
+
 /// Checks the sizes a problem is built with against the ranges a case file allows: basis
 /// pairs 0..=32, panels 1..=2000, Gauss points 1..=16, sample intervals 1..=2000; the error
 /// names the size outside its range (`basis_pairs`, `panels`, `gauss_points`, `samples`).
@@ -43,7 +46,7 @@ pub fn check_sizes(
         ("basis_pairs", basis_pairs, 0..=32),
         ("panels", panels, 1..=2000),
         ("gauss_points", gauss_points, 1..=16),
-        ("samples", samples, 1..=2000),
+        ("samples", samples, 1..=MAX_SAMPLES),
     ] {
         if !range.contains(&value) {
             return Err(crate::error::SettingsError::new(

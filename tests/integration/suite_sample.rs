@@ -691,26 +691,83 @@ fn an_end_bulging_into_an_obstacle_is_held_off_it_and_plans() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
-/// The suite's planar problem `planar_5_11` (seed 5), planned with the defaults: its start
-/// shape rests on a ball near the controlled end, and the rod bulges into it between the
-/// contact points its static solve holds clear, also with the contacts on their chords. Every
-/// path starts there, so none is collision-free on the verification grid. Checked
-/// independently: on a grid four times finer in s than the verification grid the start shape
-/// lies more than 1e-4 L inside the ball; the planner reports that end and obstacle, runs no
-/// optimiser, no replay and no fallback, and calls the plan a collision; the CLI exits with
-/// code 4 and names the end, the obstacle and the depth.
+/// The suite's planar problem `planar_23_32` (seed 23), planned with the defaults: with the
+/// case's 32 contact samples its start shape, resting on an obstacle, dips into it between
+/// them on the verification grid (the start pose's solve holds the rod clear only at the
+/// points, also on their chords), so no path from it would be collision-free. The planner is
+/// made again with 64 samples, its end solves started from the shapes that dipped, and says
+/// so. Checked independently: on a grid four times finer in s than the verification grid the
+/// case's own start shape lies more than 1e-4 L inside the obstacle; at the verification
+/// grid's points both of the planner's end shapes are clear to −1e-6 L (between them, on the
+/// finer grid, the start dips 4.3e-6 L, a thousandth of the rod's radius, measured), and the
+/// start holds the same end pose (to 1e-9 L); the plan is executable, its shapes clear to
+/// −1e-6 L on a grid finer in k and s, and the report says the samples used.
+#[test]
+fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
+    use dlo_planner::planner::observer::Silent;
+    use dlo_planner::planner::verify::fine_model;
+    let (text, p) = planar_planner(23, 32);
+    let l = p.base.model.rod.length;
+    let refined = p.contact_refinement.as_ref().expect("more contact samples");
+    assert_eq!((refined.case_samples, refined.samples), (32, 64));
+    assert_eq!(refined.dipped.end, "start");
+    let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
+    // The case's own planner, with its 32 samples.
+    let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/planar.json"))
+        .expect("a generated case");
+    let (problem, settings) = dlo_planner::case::plan::plan_problem(&c).expect("a plan");
+    let own = dlo_planner::planner::Planner::new(problem, settings).expect("ends solve");
+    let depth = clearance_on(&own, &fine, &own.start.a);
+    assert!(depth < -1e-4 * l, "{depth}");
+    assert!(
+        (refined.dipped.clearance - depth).abs() <= 1e-3 * l,
+        "{refined:?} vs {depth}"
+    );
+    let grid = fine_model(&p.base.model, p.settings.verify_s_samples, 2);
+    for a in [&p.start.a, &p.goal.a] {
+        let c = clearance_on(&p, &grid, a);
+        assert!(c >= -1e-6 * l, "{c}");
+    }
+    let tip = |a: &[f64]| *p.base.model.evaluate(a).positions.last().expect("points");
+    let (x, y) = (tip(&p.start.a), tip(&own.start.a));
+    assert!(
+        (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9),
+        "{x:?} vs {y:?}"
+    );
+    let r = p.run(&mut Silent);
+    assert!(r.end_inside_obstacle.is_none());
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    assert_eq!(r.contact_samples.as_ref(), Some(refined));
+    if r.executed_path() == Some("optimal") {
+        let v = on_a_finer_grid(&p, &r);
+        assert!(v.min_clearance.expect("obstacles") >= -1e-6 * l);
+    } else {
+        held_on_the_trajectory_clear_of_obstacles(&p, &r);
+    }
+}
+
+/// The suite's planar problem `planar_5_30` (seed 5), planned with the defaults: its goal
+/// shape rests on an obstacle near the controlled end, and the rod bulges into it between the
+/// contact points its static solve holds clear, also with the contacts on their chords, and
+/// with twice and four times the case's contact samples. Every path ends there, so none is
+/// collision-free on the verification grid. Checked independently: on a grid four times finer
+/// in s than the verification grid the goal shape lies more than 1e-4 L inside the obstacle;
+/// the planner reports that end and obstacle, runs no optimiser, no replay and no fallback,
+/// and calls the plan a collision; the CLI exits with code 4 and names the end, the obstacle
+/// and the depth.
 #[test]
 fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     use dlo_planner::planner::verify::fine_model;
     use dlo_planner::planner::{PlanStatus, PlanVerdict, observer::Silent};
-    let (text, p) = planar_planner(5, 11);
+    let (text, p) = planar_planner(5, 30);
     let l = p.base.model.rod.length;
     let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
-    let depth = clearance_on(&p, &fine, &p.start.a);
+    let depth = clearance_on(&p, &fine, &p.goal.a);
     assert!(depth < -1e-4 * l, "{depth}");
+    assert!(p.contact_refinement.is_none());
     let r = p.run(&mut Silent);
-    let e = r.end_inside_obstacle.as_ref().expect("the start is inside");
-    assert_eq!((e.end, e.obstacle.as_str()), ("start", "o1"));
+    let e = r.end_inside_obstacle.as_ref().expect("the goal is inside");
+    assert_eq!((e.end, e.obstacle.as_str()), ("goal", "o1"));
     assert!(
         e.clearance < -1e-6 * l && e.clearance >= depth - 1e-12,
         "{e:?} vs {depth}"
@@ -722,7 +779,7 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
 
     let dir = std::env::temp_dir().join(format!("dlo-end-inside-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("planar_11.json");
+    let file = dir.join("planar_30.json");
     std::fs::write(&file, &text).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_dlo"))
         .args(["plan", "--json", "--log-dir"])
@@ -733,11 +790,11 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(4), "{stderr}");
     assert!(
-        stderr.contains("the start shape itself comes") && stderr.contains("inside obstacle o1"),
+        stderr.contains("the goal shape itself comes") && stderr.contains("inside obstacle o1"),
         "{stderr}"
     );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["end_inside_obstacle"]["end"], "start");
+    assert_eq!(report["end_inside_obstacle"]["end"], "goal");
     assert_eq!(report["verdict"], "obstacle_collision");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -87,7 +87,7 @@ pub(crate) fn run_plan(
         if time_limit.is_some() {
             settings.time_limit = time_limit;
         }
-        Planner::new(problem, settings)
+        case::plan::planner(&c, problem, settings)
     });
     let planner = match built {
         Ok(Ok(p)) => p,
@@ -443,6 +443,18 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             .map_or("n/a".into(), |c| format!("{c:.4e}")),
         p.violation
     );
+    if let Some(c) = &p.contact_samples {
+        let _ = writeln!(
+            o,
+            "  contact samples: {} (the case's {} let the {} shape dip {:.3e} into obstacle {} at s = {:.4} between them)",
+            c.samples,
+            c.case_samples,
+            c.dipped.end,
+            -c.dipped.clearance,
+            c.dipped.obstacle,
+            c.dipped.s
+        );
+    }
     if p.starts.len() + p.starts_not_run > 1 {
         // Starts with fallback path terms ran: say which count each start used.
         let fallback = p
