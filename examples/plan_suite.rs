@@ -7,6 +7,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1 --only 3d   # plan the 3D problems only
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
+//!     cargo run --release --example plan_suite -- --seed 1 --family hanging   # another family
 //!
 //! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
 //! three obstacles (boxes, balls, capsules along y) beyond its swing, start and goal end poses
@@ -16,6 +17,9 @@
 //! balls, boxes and the triangle-mesh cube of `planning_cases/meshes`, start and goal
 //! positions on opposite sides with tangents and twists. Problems whose start or goal has no
 //! static shape (or lies inside an obstacle) are generated again and not counted.
+//! The hanging family (`--family hanging`, [`hanging_problem`]), planar problems of another
+//! style that no default was chosen on: a heavy strip clamped along +x, hanging among
+//! obstacles below and beside its clamp.
 //!
 //! For each problem: whether the plan is collision-free (`planned`) and coincides with its
 //! replay, whether the replay snaps, the plan time (end solves, plan, verification and
@@ -109,6 +113,65 @@ pub fn planar_problem(rng: &mut Rng, i: usize) -> String {
   "constraints": [{{"type": "orientation", "s": 0.0, "theta": 0.0}}],
   "obstacles": [{}],
   "plan": {{"start": {start}, "goal": {goal}}}}}"#,
+        obstacles.join(", ")
+    )
+}
+
+/// A problem of the hanging family (`--family hanging`), unlike those the defaults were chosen
+/// on: the strip clamped at the origin along +x (θ(0) = π/2), most of it heavy (weight 1–10
+/// per length, four problems in five), so that it hangs; one or two obstacles below and beside
+/// the clamp, among which it hangs; start and goal end poses anywhere to the right of the
+/// clamp, from 0.55 L to 0.9 L away, two in three with an end angle within 0.6 rad of pointing
+/// away from the clamp.
+pub fn hanging_problem(rng: &mut Rng, i: usize) -> String {
+    let n_obs = 1 + rng.below(2);
+    let mut obstacles = Vec::new();
+    for j in 0..n_obs {
+        let x = rng.uniform(0.25, 0.75);
+        let z = rng.uniform(-0.5, 0.25);
+        let shape = match rng.below(3) {
+            0 => format!(
+                r#"{{"type": "cuboid", "half_extents": [{}, 0.5, {}]}}"#,
+                rng.uniform(0.03, 0.12),
+                rng.uniform(0.03, 0.12)
+            ),
+            1 => format!(
+                r#"{{"type": "ball", "radius": {}}}"#,
+                rng.uniform(0.04, 0.12)
+            ),
+            _ => format!(
+                r#"{{"type": "capsule", "a": [0, -0.5, 0], "b": [0, 0.5, 0], "radius": {}}}"#,
+                rng.uniform(0.03, 0.08)
+            ),
+        };
+        obstacles.push(format!(
+            r#"{{"name": "o{j}", "shape": {shape}, "position": [{x}, 0, {z}]}}"#
+        ));
+    }
+    let end = |rng: &mut Rng| {
+        let r = rng.uniform(0.55, 0.9);
+        let a = rng.uniform(-1.2, 1.0);
+        let (x, z) = (r * a.cos(), r * a.sin());
+        if rng.below(3) == 0 {
+            format!(r#"{{"x": {x}, "z": {z}}}"#)
+        } else {
+            let theta = std::f64::consts::FRAC_PI_2 - a + rng.uniform(-0.6, 0.6);
+            format!(r#"{{"x": {x}, "z": {z}, "theta": {theta}}}"#)
+        }
+    };
+    let (start, goal) = (end(rng), end(rng));
+    let weight = if rng.below(5) == 0 {
+        0.0
+    } else {
+        rng.uniform(1.0, 10.0)
+    };
+    format!(
+        r#"{{"name": "hanging_{i}", "planar": true,
+  "rod": {{"length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005, "weight_per_length": {weight}}},
+  "constraints": [{{"type": "orientation", "s": 0.0, "theta": {}}}],
+  "obstacles": [{}],
+  "plan": {{"start": {start}, "goal": {goal}}}}}"#,
+        std::f64::consts::FRAC_PI_2,
         obstacles.join(", ")
     )
 }
@@ -416,8 +479,20 @@ fn main() {
             .map_or(default, |v| v.parse().expect("a number"))
     };
     let seed = arg("--seed", 1);
+    // `--family hanging`: the planar problems of [`hanging_problem`] instead of the suite's,
+    // and no 3D problems unless `--spatial` asks for them.
+    let hanging = args
+        .iter()
+        .position(|a| a == "--family")
+        .and_then(|i| args.get(i + 1))
+        .map(|f| {
+            assert!(f == "hanging", "--family: only `hanging`");
+            true
+        })
+        .unwrap_or(false);
     let n_planar = arg("--planar", 60) as usize;
-    let n_spatial = arg("--spatial", 30) as usize;
+    let n_spatial = arg("--spatial", if hanging { 0 } else { 30 }) as usize;
+    let planar_kind = if hanging { "hanging" } else { "planar" };
     let verbose = args.iter().any(|a| a == "--verbose");
     // `--write DIR`: every generated case file is written there, for `dlo plan DIR/NAME.json`.
     let write_dir = args
@@ -451,8 +526,10 @@ fn main() {
     for (kind, count) in [(0, n_planar), (1, n_spatial)] {
         let mut i = 0;
         while results[kind].len() < count {
-            let name = format!("{}_{seed}_{i}", ["planar", "spatial"][kind]);
-            let text = if kind == 0 {
+            let name = format!("{}_{seed}_{i}", [planar_kind, "spatial"][kind]);
+            let text = if kind == 0 && hanging {
+                hanging_problem(&mut rng, i)
+            } else if kind == 0 {
                 planar_problem(&mut rng, i)
             } else {
                 spatial_problem(&mut rng, i)
@@ -512,7 +589,7 @@ fn main() {
         }
     }
     println!(
-        "Suite seed {seed}: {} planar and {} 3D problems (generated again where start or goal has no static shape: {} planar, {} 3D), planner settings {}{}.\n",
+        "Suite seed {seed}: {} {planar_kind} and {} 3D problems (generated again where start or goal has no static shape: {} {planar_kind}, {} 3D), planner settings {}{}.\n",
         n_planar,
         n_spatial,
         regenerated[0],
@@ -532,6 +609,8 @@ fn main() {
         "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    print!("{}", table("planar", &results[0]));
-    print!("{}", table("3D", &results[1]));
+    print!("{}", table(planar_kind, &results[0]));
+    if n_spatial > 0 {
+        print!("{}", table("3D", &results[1]));
+    }
 }
