@@ -63,31 +63,52 @@ impl Rng {
     }
 }
 
+/// Ranges of a generated planar obstacle: its centre's x and z, a box's half-extents in x and
+/// z, a ball's radius and a bar's (a capsule along y).
+struct ObstacleRanges {
+    x: (f64, f64),
+    z: (f64, f64),
+    box_x: (f64, f64),
+    box_z: (f64, f64),
+    ball: (f64, f64),
+    bar: (f64, f64),
+}
+
+/// Obstacle `j` of a planar problem, drawn from `r`: a box, a ball or a bar, one in three each.
+fn planar_obstacle(rng: &mut Rng, j: usize, r: &ObstacleRanges) -> String {
+    let x = rng.uniform(r.x.0, r.x.1);
+    let z = rng.uniform(r.z.0, r.z.1);
+    let shape = match rng.below(3) {
+        0 => format!(
+            r#"{{"type": "cuboid", "half_extents": [{}, 0.5, {}]}}"#,
+            rng.uniform(r.box_x.0, r.box_x.1),
+            rng.uniform(r.box_z.0, r.box_z.1)
+        ),
+        1 => format!(
+            r#"{{"type": "ball", "radius": {}}}"#,
+            rng.uniform(r.ball.0, r.ball.1)
+        ),
+        _ => format!(
+            r#"{{"type": "capsule", "a": [0, -0.5, 0], "b": [0, 0.5, 0], "radius": {}}}"#,
+            rng.uniform(r.bar.0, r.bar.1)
+        ),
+    };
+    format!(r#"{{"name": "o{j}", "shape": {shape}, "position": [{x}, 0, {z}]}}"#)
+}
+
 pub fn planar_problem(rng: &mut Rng, i: usize) -> String {
     let n_obs = 1 + rng.below(3);
-    let mut obstacles = Vec::new();
-    for j in 0..n_obs {
-        let x = rng.uniform(-0.25, 0.25);
-        let z = rng.uniform(0.75, 1.15);
-        let shape = match rng.below(3) {
-            0 => format!(
-                r#"{{"type": "cuboid", "half_extents": [{}, 0.5, {}]}}"#,
-                rng.uniform(0.04, 0.2),
-                rng.uniform(0.04, 0.3)
-            ),
-            1 => format!(
-                r#"{{"type": "ball", "radius": {}}}"#,
-                rng.uniform(0.04, 0.15)
-            ),
-            _ => format!(
-                r#"{{"type": "capsule", "a": [0, -0.5, 0], "b": [0, 0.5, 0], "radius": {}}}"#,
-                rng.uniform(0.03, 0.1)
-            ),
-        };
-        obstacles.push(format!(
-            r#"{{"name": "o{j}", "shape": {shape}, "position": [{x}, 0, {z}]}}"#
-        ));
-    }
+    let ranges = ObstacleRanges {
+        x: (-0.25, 0.25),
+        z: (0.75, 1.15),
+        box_x: (0.04, 0.2),
+        box_z: (0.04, 0.3),
+        ball: (0.04, 0.15),
+        bar: (0.03, 0.1),
+    };
+    let obstacles: Vec<String> = (0..n_obs)
+        .map(|j| planar_obstacle(rng, j, &ranges))
+        .collect();
     let end = |rng: &mut Rng, side: f64| {
         let r = rng.uniform(0.55, 0.9);
         let a = side * rng.uniform(0.25, 0.7);
@@ -125,29 +146,17 @@ pub fn planar_problem(rng: &mut Rng, i: usize) -> String {
 /// away from the clamp.
 pub fn hanging_problem(rng: &mut Rng, i: usize) -> String {
     let n_obs = 1 + rng.below(2);
-    let mut obstacles = Vec::new();
-    for j in 0..n_obs {
-        let x = rng.uniform(0.25, 0.75);
-        let z = rng.uniform(-0.5, 0.25);
-        let shape = match rng.below(3) {
-            0 => format!(
-                r#"{{"type": "cuboid", "half_extents": [{}, 0.5, {}]}}"#,
-                rng.uniform(0.03, 0.12),
-                rng.uniform(0.03, 0.12)
-            ),
-            1 => format!(
-                r#"{{"type": "ball", "radius": {}}}"#,
-                rng.uniform(0.04, 0.12)
-            ),
-            _ => format!(
-                r#"{{"type": "capsule", "a": [0, -0.5, 0], "b": [0, 0.5, 0], "radius": {}}}"#,
-                rng.uniform(0.03, 0.08)
-            ),
-        };
-        obstacles.push(format!(
-            r#"{{"name": "o{j}", "shape": {shape}, "position": [{x}, 0, {z}]}}"#
-        ));
-    }
+    let ranges = ObstacleRanges {
+        x: (0.25, 0.75),
+        z: (-0.5, 0.25),
+        box_x: (0.03, 0.12),
+        box_z: (0.03, 0.12),
+        ball: (0.04, 0.12),
+        bar: (0.03, 0.08),
+    };
+    let obstacles: Vec<String> = (0..n_obs)
+        .map(|j| planar_obstacle(rng, j, &ranges))
+        .collect();
     let end = |rng: &mut Rng| {
         let r = rng.uniform(0.55, 0.9);
         let a = rng.uniform(-1.2, 1.0);
