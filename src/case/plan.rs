@@ -367,7 +367,7 @@ pub fn planner(
 ) -> Result<crate::planner::Planner, crate::planner::PlanSetupError> {
     use crate::planner::{ContactRefinement, Planner};
     let own = Planner::new(problem.clone(), settings.clone())?;
-    let Some(dipped) = own.end_dip(1) else {
+    let Some(dipped) = own.end_dip() else {
         return Ok(own);
     };
     let case_samples = case.builder.sample_count();
@@ -390,7 +390,7 @@ pub fn planner(
         let Ok(mut p) = Planner::new(seeded.clone(), settings.clone()) else {
             break;
         };
-        if p.end_dip(1).is_none() {
+        if p.end_dip().is_none() {
             p.contact_refinement = Some(ContactRefinement {
                 case_samples,
                 samples: n,

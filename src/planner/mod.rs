@@ -899,13 +899,12 @@ impl Planner {
             .collect()
     }
 
-    /// The deepest place where an end shape lies inside an obstacle, deeper than the
-    /// collision tolerance, although its static solve holds it clear at the contact points
-    /// (and on their chords, held off, where it dipped between them), on the verification grid
-    /// in s made `finer` times finer (1: the grid itself, on which such an end leaves no path
-    /// collision-free, [`PlanResult::end_inside_obstacle`]).
-    pub fn end_dip(&self, finer: usize) -> Option<EndInside> {
-        let fine = fine_model(&self.base.model, finer * self.settings.verify_s_samples, 4);
+    /// The deepest place where an end shape lies inside an obstacle on the verification grid,
+    /// deeper than the collision tolerance, although its static solve holds it clear at the
+    /// contact points (and on their chords, held off, where it dipped between them): with
+    /// such an end no path is collision-free ([`PlanResult::end_inside_obstacle`]).
+    pub fn end_dip(&self) -> Option<EndInside> {
+        let fine = fine_model(&self.base.model, self.settings.verify_s_samples, 4);
         self.end_inside_obstacle(&self.end_clearances(&fine))
     }
 
