@@ -355,8 +355,9 @@ const CONTACT_DOUBLINGS: u32 = 2;
 /// between the contact points its solve holds clear, on the verification grid
 /// ([`crate::planner::Planner::end_dip`]: a rod wrapped round an obstacle whose radius is not
 /// much larger than the points' spacing), the case's problem is made again with twice the
-/// contact samples (`discretisation.samples`), and again with four times, within their
-/// limits, its end solves started from the shapes solved before. The first whose end shapes
+/// contact samples (`discretisation.samples`), and again with four times (with self-contact,
+/// whose rows grow as the samples squared, twice only), within their limits, its end solves
+/// started from the shapes solved before. The first whose end shapes
 /// rest clear on the verification grid is the planner, and says so
 /// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
 /// plan then reports the end inside the obstacle).
@@ -371,15 +372,16 @@ pub fn planner(
         return Ok(own);
     };
     let case_samples = case.builder.sample_count();
-    let most = if case.builder.has_self_contact() {
-        super::limits::MAX_SELF_CONTACT_SAMPLES
+    // Self-contact rows grow as the samples squared: one doubling only.
+    let (most, doublings) = if case.builder.has_self_contact() {
+        (super::limits::MAX_SELF_CONTACT_SAMPLES, 1)
     } else {
-        crate::rod::model::MAX_SAMPLES
+        (crate::rod::model::MAX_SAMPLES, CONTACT_DOUBLINGS)
     };
     let mut seeded = problem;
     seeded.start.shape = Some(own.start.a.clone());
     seeded.goal.shape = Some(own.goal.a.clone());
-    for n in (1..=CONTACT_DOUBLINGS).map(|d| case_samples << d) {
+    for n in (1..=doublings).map(|d| case_samples << d) {
         if n > most {
             break;
         }

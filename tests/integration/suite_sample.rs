@@ -746,6 +746,40 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
     }
 }
 
+/// The suite's 3D problem `spatial_46_17` (seed 46, which draws 62 planar problems before its
+/// 3D ones): an end shape dips into an obstacle between the case's 32 contact points and
+/// between 64, and rests clear on the verification grid with 128, which the planner is made
+/// with. With self-contact on (its rows grow as the samples squared) the samples are doubled
+/// once only: the planner keeps the case's 32 and its end still dips.
+#[test]
+fn contact_samples_are_doubled_once_only_with_self_contact() {
+    let mut rng = Rng(46);
+    for j in 0..62 {
+        planar_problem(&mut rng, j);
+    }
+    let text = (0..=17)
+        .map(|j| spatial_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let planner = |self_contact: bool| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).expect("generated JSON");
+        v["self_contact"] = serde_json::json!(self_contact);
+        let c = dlo_planner::case::parse(
+            &v.to_string(),
+            std::path::Path::new("planning_cases/spatial_46_17.json"),
+        )
+        .expect("a generated case");
+        dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve")
+    };
+    let p = planner(false);
+    let refined = p.contact_refinement.as_ref().expect("more contact samples");
+    assert_eq!((refined.case_samples, refined.samples), (32, 128));
+    assert!(p.end_dip().is_none());
+    let q = planner(true);
+    assert!(q.contact_refinement.is_none());
+    assert!(q.end_dip().is_some());
+}
+
 /// The suite's planar problem `planar_5_30` (seed 5), planned with the defaults: its goal
 /// shape rests on an obstacle near the controlled end, and the rod bulges into it between the
 /// contact points its static solve holds clear, also with the contacts on their chords, and
