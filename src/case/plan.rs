@@ -373,7 +373,7 @@ pub fn planner(
     };
     let case_samples = case.builder.sample_count();
     // Self-contact rows grow as the samples squared: one doubling only.
-    let (most, doublings) = if case.builder.has_self_contact() {
+    let (most, doublings) = if own.has_self_contact() {
         (super::limits::MAX_SELF_CONTACT_SAMPLES, 1)
     } else {
         (crate::rod::model::MAX_SAMPLES, CONTACT_DOUBLINGS)

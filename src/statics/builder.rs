@@ -128,11 +128,6 @@ impl StaticProblemBuilder {
         self.samples
     }
 
-    /// Whether the problem holds self-contact ([`Self::self_contact`]).
-    pub fn has_self_contact(&self) -> bool {
-        self.self_contact
-    }
-
     /// Obstacle contacts held on the chords between sample points, not at the points alone
     /// (see [`crate::constraints::ObstacleConstraint`]; default `false`).
     pub fn chord_contacts(mut self, on: bool) -> Self {

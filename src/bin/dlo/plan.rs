@@ -298,15 +298,14 @@ pub(crate) enum Failure {
 pub(crate) fn what_to_try(planner: &Planner, failure: Failure) -> String {
     let s = &planner.settings;
     let spatial = planner.base.model.layout.spatial;
+    // The counts the run tried and one more; none tried: two, from six terms on.
     let mut terms = s.fallback_terms(spatial);
-    let largest = terms.iter().copied().max().unwrap_or(s.path_terms);
-    terms.push(if terms.is_empty() {
-        s.path_terms.max(4) + 2
-    } else {
-        largest + 4
-    });
-    if terms.len() == 1 {
-        terms.push(terms[0] + 2);
+    match terms.iter().max() {
+        Some(&largest) => terms.push(largest + 4),
+        None => {
+            let first = s.path_terms.max(4) + 2;
+            terms.extend([first, first + 2]);
+        }
     }
     let terms = format!(
         "more path terms (plan.fallback_path_terms: [{}])",
