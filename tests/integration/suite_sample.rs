@@ -368,14 +368,7 @@ fn suite_3d_plan_observed(
 ) {
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
-    let mut rng = Rng(1);
-    for j in 0..68 {
-        planar_problem(&mut rng, j);
-    }
-    let text = (0..=i)
-        .map(|j| spatial_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
+    let text = spatial_text(1, 68, i);
     let mut case: serde_json::Value = serde_json::from_str(&text).expect("JSON");
     for (k, v) in plan.as_object().expect("an object") {
         case["plan"][k] = v.clone();
@@ -753,14 +746,7 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
 /// once only: the planner keeps the case's 32 and its end still dips.
 #[test]
 fn contact_samples_are_doubled_once_only_with_self_contact() {
-    let mut rng = Rng(46);
-    for j in 0..62 {
-        planar_problem(&mut rng, j);
-    }
-    let text = (0..=17)
-        .map(|j| spatial_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
+    let text = spatial_text(46, 62, 17);
     let planner = |self_contact: bool| {
         let mut v: serde_json::Value = serde_json::from_str(&text).expect("generated JSON");
         v["self_contact"] = serde_json::json!(self_contact);
@@ -869,16 +855,22 @@ fn a_replay_ends_at_its_first_unconverged_solve() {
     assert!(!early.coincide && !early.all_converged);
 }
 
-/// The suite's 3D problem `spatial_6_9` (seed 6), with the defaults.
-fn spatial_6_9() -> dlo_planner::planner::Planner {
-    let mut rng = Rng(6);
-    for j in 0..67 {
+/// The case text of the suite's 3D problem `spatial_{seed}_{index}`, whose seed draws
+/// `planar_draws` planar problems (its 60 and those generated again) before its 3D ones.
+fn spatial_text(seed: u64, planar_draws: usize, index: usize) -> String {
+    let mut rng = Rng(seed);
+    for j in 0..planar_draws {
         planar_problem(&mut rng, j);
     }
-    let text = (0..=9)
+    (0..=index)
         .map(|j| spatial_problem(&mut rng, j))
         .last()
-        .expect("a problem");
+        .expect("a problem")
+}
+
+/// The suite's 3D problem `spatial_6_9` (seed 6), with the defaults.
+fn spatial_6_9() -> dlo_planner::planner::Planner {
+    let text = spatial_text(6, 67, 9);
     let path = std::path::Path::new("planning_cases/spatial_6_9.json");
     let c = dlo_planner::case::parse(&text, path).expect("a generated case");
     dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve")
