@@ -360,13 +360,14 @@ const CONTACT_DOUBLINGS: u32 = 2;
 /// started from the shapes solved before. The first whose end shapes
 /// rest clear on the verification grid is the planner, and says so
 /// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
-/// plan then reports the end inside the obstacle).
+/// plan then reports the end inside the obstacle). Either way the planner lists the tries
+/// whose end shapes still dipped ([`crate::planner::Planner::contact_tries`]).
 pub fn planner(
     case: &Case,
     problem: crate::planner::PlanProblem,
     settings: PlanSettings,
 ) -> Result<crate::planner::Planner, crate::planner::PlanSetupError> {
-    use crate::planner::{ContactRefinement, Planner};
+    use crate::planner::{ContactRefinement, ContactTry, Planner};
     let own = Planner::new(problem.clone(), settings.clone())?;
     let Some(dipped) = own.end_dip() else {
         return Ok(own);
@@ -381,6 +382,7 @@ pub fn planner(
     let mut seeded = problem;
     seeded.start.shape = Some(own.start.a.clone());
     seeded.goal.shape = Some(own.goal.a.clone());
+    let mut tries = Vec::new();
     for n in (1..=doublings).map(|d| case_samples << d) {
         if n > most {
             break;
@@ -390,18 +392,31 @@ pub fn planner(
         };
         seeded.statics = statics;
         let Ok(mut p) = Planner::new(seeded.clone(), settings.clone()) else {
+            tries.push(ContactTry {
+                samples: n,
+                dipped: None,
+            });
             break;
         };
-        if p.end_dip().is_none() {
-            p.contact_refinement = Some(ContactRefinement {
-                case_samples,
+        match p.end_dip() {
+            None => {
+                p.contact_refinement = Some(ContactRefinement {
+                    case_samples,
+                    samples: n,
+                    dipped,
+                });
+                p.contact_tries = tries;
+                return Ok(p);
+            }
+            still => tries.push(ContactTry {
                 samples: n,
-                dipped,
-            });
-            return Ok(p);
+                dipped: still,
+            }),
         }
         seeded.start.shape = Some(p.start.a.clone());
         seeded.goal.shape = Some(p.goal.a.clone());
     }
+    let mut own = own;
+    own.contact_tries = tries;
     Ok(own)
 }

@@ -42,8 +42,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use verify::fine_model;
 
 pub use result::{
-    Attempt, ContactRefinement, EndInside, PlanReport, PlanResult, PlanStatus, PlanVerdict,
-    StartSummary, Timing,
+    Attempt, ContactRefinement, ContactTry, EndInside, PlanReport, PlanResult, PlanStatus,
+    PlanVerdict, StartSummary, Timing,
 };
 use start::Verified;
 use starts::StartPlan;
@@ -161,6 +161,10 @@ pub struct Planner {
     /// shape dipped into an obstacle between the case's (set by
     /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples`]).
     pub contact_refinement: Option<ContactRefinement>,
+    /// The planners made with more contact samples whose end shapes still dipped, or did not
+    /// solve (set by
+    /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples_tried`]).
+    pub contact_tries: Vec<ContactTry>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
@@ -829,6 +833,7 @@ impl Planner {
             held,
             start_contacts,
             contact_refinement: None,
+            contact_tries: Vec::new(),
             base: problem.statics,
             obstacles: problem.obstacles,
             static_options,
@@ -1308,6 +1313,7 @@ impl Planner {
             straight_path_plan: best.is_none() && end_inside.is_none(),
             end_inside_obstacle: end_inside,
             contact_samples: self.contact_refinement.clone(),
+            contact_samples_tried: self.contact_tries.clone(),
             u_max: ver.u_max,
             k_at_u_max: ver.k_at_u_max,
             sampled_u_max: chosen.sampled_max,

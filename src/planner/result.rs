@@ -198,6 +198,11 @@ pub struct PlanResult {
     /// otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_samples: Option<ContactRefinement>,
+    /// The plans made again with more contact samples whose end shape still dipped into an
+    /// obstacle between them (or whose end solves failed), in the order tried
+    /// ([`ContactTry`]); absent where none was.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contact_samples_tried: Vec<ContactTry>,
     /// True `U_max` of the plan on the verification grid (case units).
     pub u_max: f64,
     /// `k` where it occurs.
@@ -315,6 +320,17 @@ pub struct ContactRefinement {
     pub samples: usize,
     /// Where the end shape dipped with the case's samples.
     pub dipped: EndInside,
+}
+
+/// A case's plan made again with more contact samples, whose end shape still dipped into an
+/// obstacle between them, or whose end solves failed ([`PlanResult::contact_samples_tried`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ContactTry {
+    /// The contact samples it was made with.
+    pub samples: usize,
+    /// Where its end shape dipped deepest; `None` where its start or goal found no static
+    /// shape (the last try then).
+    pub dipped: Option<EndInside>,
 }
 
 /// Where an end shape lies inside an obstacle ([`PlanResult::end_inside_obstacle`]).

@@ -727,10 +727,12 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
         (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9),
         "{x:?} vs {y:?}"
     );
+    assert!(p.contact_tries.is_empty());
     let r = p.run(&mut Silent);
     assert!(r.end_inside_obstacle.is_none());
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.contact_samples.as_ref(), Some(refined));
+    assert!(r.contact_samples_tried.is_empty());
     if r.executed_path() == Some("optimal") {
         let v = on_a_finer_grid(&p, &r);
         assert!(v.min_clearance.expect("obstacles") >= -1e-6 * l);
@@ -761,9 +763,21 @@ fn contact_samples_are_doubled_once_only_with_self_contact() {
     let refined = p.contact_refinement.as_ref().expect("more contact samples");
     assert_eq!((refined.case_samples, refined.samples), (32, 128));
     assert!(p.end_dip().is_none());
+    let l = p.base.model.rod.length;
+    let dipped_with = |tries: &[dlo_planner::planner::ContactTry]| {
+        assert!(
+            tries
+                .iter()
+                .all(|t| t.dipped.as_ref().is_some_and(|d| d.clearance < -1e-6 * l)),
+            "{tries:?}"
+        );
+        tries.iter().map(|t| t.samples).collect::<Vec<_>>()
+    };
+    assert_eq!(dipped_with(&p.contact_tries), [64]);
     let q = planner(true);
     assert!(q.contact_refinement.is_none());
     assert!(q.end_dip().is_some());
+    assert_eq!(dipped_with(&q.contact_tries), [64]);
 }
 
 /// The suite's planar problem `planar_5_30` (seed 5), planned with the defaults: its goal
@@ -773,8 +787,9 @@ fn contact_samples_are_doubled_once_only_with_self_contact() {
 /// collision-free on the verification grid. Checked independently: on a grid four times finer
 /// in s than the verification grid the goal shape lies more than 1e-4 L inside the obstacle;
 /// the planner reports that end and obstacle, runs no optimiser, no replay and no fallback,
-/// and calls the plan a collision; the CLI exits with code 4 and names the end, the obstacle
-/// and the depth.
+/// and calls the plan a collision, listing the tries with more contact samples: with 64 the
+/// goal still dips, with 128 it has no static shape. The CLI exits with code 4 and names the
+/// end, the obstacle, the depth and the tries.
 #[test]
 fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     use dlo_planner::planner::verify::fine_model;
@@ -785,7 +800,15 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     let depth = clearance_on(&p, &fine, &p.goal.a);
     assert!(depth < -1e-4 * l, "{depth}");
     assert!(p.contact_refinement.is_none());
+    // With 64 samples the goal still dips deeper than the tolerance; with 128 it has no
+    // static shape (from the 64 samples' shapes, as from the natural state).
+    let tried: Vec<usize> = p.contact_tries.iter().map(|t| t.samples).collect();
+    assert_eq!(tried, [64, 128]);
+    let d64 = p.contact_tries[0].dipped.as_ref().expect("solved with 64");
+    assert!(d64.clearance < -1e-6 * l, "{d64:?}");
+    assert!(p.contact_tries[1].dipped.is_none());
     let r = p.run(&mut Silent);
+    assert_eq!(r.contact_samples_tried, p.contact_tries);
     let e = r.end_inside_obstacle.as_ref().expect("the goal is inside");
     assert_eq!((e.end, e.obstacle.as_str()), ("goal", "o1"));
     assert!(
@@ -813,8 +836,17 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
         stderr.contains("the goal shape itself comes") && stderr.contains("inside obstacle o1"),
         "{stderr}"
     );
+    // What was tried, and what is left to try.
+    assert!(
+        stderr.contains(&format!(
+            "made again with more contact points: dips {:.3e} with 64, no static end shape with 128)",
+            -d64.clearance
+        )) && stderr.ends_with("try an end pose farther from the obstacle\n"),
+        "{stderr}"
+    );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["end_inside_obstacle"]["end"], "goal");
+    assert_eq!(report["contact_samples_tried"][1]["samples"], 128);
     assert_eq!(report["verdict"], "obstacle_collision");
     std::fs::remove_dir_all(&dir).unwrap();
 }
