@@ -243,6 +243,13 @@ impl Planner {
         } else {
             (Vec::new(), al.rho_initial)
         };
+        // No stage to run (a lifted plan, tracked only): the objective of the sharpest stage,
+        // which its source ended with.
+        if let Some(&b) = self.settings.sharpness.last()
+            && from.stage >= self.settings.sharpness.len()
+        {
+            p.beta = b / u_ref;
+        }
         // A quick start's samples peak at an end shape at the current `z`, where measured.
         let mut at_end = None;
         for (stage, &b) in self.settings.sharpness.iter().enumerate().skip(from.stage) {
