@@ -361,7 +361,8 @@ const CONTACT_DOUBLINGS: u32 = 2;
 /// rest clear on the verification grid is the planner, and says so
 /// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
 /// plan then reports the end inside the obstacle). Either way the planner lists the tries
-/// whose end shapes still dipped ([`crate::planner::Planner::contact_tries`]).
+/// whose end shapes still dipped, or did not solve
+/// ([`crate::planner::Planner::contact_tries`]).
 pub fn planner(
     case: &Case,
     problem: crate::planner::PlanProblem,

@@ -162,8 +162,8 @@ pub struct Planner {
     /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples`]).
     pub contact_refinement: Option<ContactRefinement>,
     /// The planners made with more contact samples whose end shapes still dipped, or did not
-    /// solve (set by
-    /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples_tried`]).
+    /// solve (set by [`crate::case::plan::planner`]; reported as
+    /// [`PlanResult::contact_samples_tried`]).
     pub contact_tries: Vec<ContactTry>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,

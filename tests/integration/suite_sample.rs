@@ -848,6 +848,21 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     assert_eq!(report["end_inside_obstacle"]["end"], "goal");
     assert_eq!(report["contact_samples_tried"][1]["samples"], 128);
     assert_eq!(report["verdict"], "obstacle_collision");
+    // The summary lists the tries on a line of its own.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dlo"))
+        .args(["plan", "--log-dir"])
+        .arg(&dir)
+        .arg(&file)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(&format!(
+            "more contact samples tried: the goal shape dips {:.3e} with 64, no static end shape with 128\n",
+            -d64.clearance
+        )),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -496,13 +496,11 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             c.dipped.s
         );
     }
-    if let (false, Some(e)) = (
-        p.contact_samples_tried.is_empty(),
-        p.contact_samples
-            .as_ref()
-            .map(|c| &c.dipped)
-            .or(p.end_inside_obstacle.as_ref()),
-    ) {
+    // Named after the end the case's own samples let dip.
+    let dipped = p.contact_samples.as_ref().map(|c| &c.dipped);
+    if !p.contact_samples_tried.is_empty()
+        && let Some(e) = dipped.or(p.end_inside_obstacle.as_ref())
+    {
         let _ = writeln!(
             o,
             "  more contact samples tried: the {} shape {}",
