@@ -369,7 +369,7 @@ pub fn planner(
     settings: PlanSettings,
 ) -> Result<crate::planner::Planner, crate::planner::PlanSetupError> {
     use crate::planner::{ContactRefinement, ContactTry, Planner};
-    let own = Planner::new(problem.clone(), settings.clone())?;
+    let mut own = Planner::new(problem.clone(), settings.clone())?;
     let Some(dipped) = own.end_dip() else {
         return Ok(own);
     };
@@ -417,7 +417,6 @@ pub fn planner(
         seeded.start.shape = Some(p.start.a.clone());
         seeded.goal.shape = Some(p.goal.a.clone());
     }
-    let mut own = own;
     own.contact_tries = tries;
     Ok(own)
 }

@@ -184,13 +184,19 @@ pub(crate) fn run_plan(
                     contact_tries_text(tries, e)
                 )
             };
-            let advice = match tries.last() {
-                None => TRY_END_INSIDE.to_string(),
-                Some(last) if last.dipped.is_some() => format!(
-                    "try an end pose farther from the obstacle, or more than {} contact points (discretisation.samples)",
-                    last.samples
+            // More contact points than any tried, unless the last try's end did not solve.
+            let more = match tries.last() {
+                None => Some("more contact points".to_string()),
+                Some(last) if last.dipped.is_some() => {
+                    Some(format!("more than {} contact points", last.samples))
+                }
+                Some(_) => None,
+            };
+            let advice = match more {
+                Some(more) => format!(
+                    "try an end pose farther from the obstacle, or {more} (discretisation.samples)"
                 ),
-                Some(_) => "try an end pose farther from the obstacle".to_string(),
+                None => "try an end pose farther from the obstacle".to_string(),
             };
             eprintln!(
                 "error: {}: no collision-free plan: the {} shape itself comes {:.3e} inside obstacle {} at s = {:.4} (between the contact points its static solve holds clear{tried}), so no path from it is collision-free on the verification grid; {advice}",
@@ -414,10 +420,6 @@ fn contact_tries_text(
         .collect::<Vec<_>>()
         .join(", ")
 }
-
-/// What to try when an end shape lies inside an obstacle between its contact points.
-pub(crate) const TRY_END_INSIDE: &str =
-    "try an end pose farther from the obstacle, or more contact points (discretisation.samples)";
 
 /// Why the replayed equilibria are not a plan either, when they were checked, and that the
 /// time limit ended the search, when it did.
