@@ -824,12 +824,18 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("planar_30.json");
     std::fs::write(&file, &text).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "--json", "--log-dir"])
-        .arg(&dir)
-        .arg(&file)
-        .output()
-        .unwrap();
+    // `dlo plan` on the case, with a JSON report or the text summary.
+    let plan = |json: bool| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_dlo"))
+            .arg("plan")
+            .args(json.then_some("--json"))
+            .arg("--log-dir")
+            .arg(&dir)
+            .arg(&file)
+            .output()
+            .unwrap()
+    };
+    let out = plan(true);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(4), "{stderr}");
     assert!(
@@ -849,12 +855,7 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     assert_eq!(report["contact_samples_tried"][1]["samples"], 128);
     assert_eq!(report["verdict"], "obstacle_collision");
     // The summary lists the tries on a line of its own.
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dlo"))
-        .args(["plan", "--log-dir"])
-        .arg(&dir)
-        .arg(&file)
-        .output()
-        .unwrap();
+    let out = plan(false);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains(&format!(
