@@ -21,17 +21,6 @@ use crate::constraints::Constraint;
 /// the start's own pose lands on its shape to the last bits.
 const STATIONARY: f64 = 1e-12;
 
-/// Most times a replay step is halved where it jumps or its solve fails, in the judgement of
-/// the equilibria along the straight path's trajectory before optimising
-/// ([`Planner::straight_trajectory_plan`]; at most `replay_refinements`). That judgement is a
-/// shortcut, and where the rod slides off an obstacle or snaps, the halving would spend many
-/// failing static solves before the optimiser runs anyway (`spatial_1_3`: 0.68 s of 2.2 s);
-/// the same judgement after every attempt has failed halves as often as the case says. On the
-/// generated suite (seeds 1–7, 12 and 46, back to back, 2026-12-05) every verdict and U_max
-/// stayed the same, and the 3D plans took 52.0 s instead of 56.1 s (`spatial_46_17` 5.4 → 2.9
-/// s); no halving at all changed nothing more.
-const SHORTCUT_REFINEMENTS: usize = 1;
-
 impl Planner {
     /// Whether the straight path `straight` (its verification) attains the lower bound on
     /// `U_max` and keeps the optimiser's clearances, so that it is worth replaying as the plan:
@@ -86,9 +75,8 @@ impl Planner {
     /// moved through the straight path's end poses, the rod sliding over the obstacle), judged
     /// as the plan when they are executable and peak within `energy_gap_tolerance` of the lower
     /// bound on `U_max` (the larger end energy): no path peaks lower by more than that, and the
-    /// gripper follows the straight path's end poses. Its replays halve a step at most
-    /// [`SHORTCUT_REFINEMENTS`] times. `None` otherwise (the replay's shapes are then dropped,
-    /// not logged).
+    /// gripper follows the straight path's end poses. `None` otherwise (the replay's shapes are
+    /// then dropped, not logged).
     pub(super) fn straight_trajectory_plan(
         &self,
         straight: &Verification,
@@ -107,9 +95,7 @@ impl Planner {
         if !ends.iter().any(|e| e.clearance < margin) {
             return None;
         }
-        let mut shortcut = self.clone();
-        shortcut.settings.replay_refinements = s.replay_refinements.min(SHORTCUT_REFINEMENTS);
-        let mut judged = shortcut.judge_straight_trajectory(fine, observer);
+        let mut judged = self.judge_straight_trajectory(fine, observer);
         let bound = self
             .start
             .energy
