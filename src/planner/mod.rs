@@ -51,9 +51,26 @@ use starts::StartPlan;
 /// Depth (a fraction of L) below which a verified clearance counts as a collision.
 const COLLISION_TOLERANCE: f64 = 1e-6;
 
+/// How many times finer in s than the verification grid the end shapes are checked for
+/// obstacles: a rod that rests on an obstacle bulges into it between the contact points its
+/// static solve holds clear (the Ritz shape cannot bend round a concentrated contact force),
+/// and a bulge narrower than the verification grid's spacing can lie between its points. Each
+/// end is one shape, so a fine grid costs little; every path starts or ends there.
+const END_GRID_REFINEMENT: usize = 4;
+
+/// The grid in s on which an end shape resting on an obstacle must be clear
+/// ([`END_GRID_REFINEMENT`] times the verification grid's `verify_s_samples` intervals).
+fn end_grid(model: &crate::rod::model::Model, verify_s_samples: usize) -> crate::rod::model::Model {
+    fine_model(model, END_GRID_REFINEMENT * verify_s_samples, 2)
+}
+
 /// Largest margin (a fraction of the coincidence tolerance) by which replayed equilibria that
 /// dip between contact points are held off the obstacles.
 const CONTACT_MARGIN_CAP: f64 = 0.05;
+
+/// How many times replayed equilibria that still dip into an obstacle between their contact
+/// points, held off it, are held off again by twice their new depth more (the first included).
+const HOLD_OFF_ROUNDS: usize = 2;
 
 /// The margin (units of L) by which a shape that dips `depth` (case units) into an obstacle
 /// between its contacts is solved again held off the obstacles: twice the depth, when that is
@@ -150,7 +167,8 @@ pub struct Planner {
     /// `base` as the replays hold the rod: as the start shape is held, with the obstacle
     /// contacts on the chords between the sample points, [`Planner::start_contacts`] off the
     /// obstacles, where the start shape needed that to rest on an obstacle clear of it (its
-    /// contacts at the points dipped into it between them on the verification grid); else
+    /// contacts at the points dipped into it between them on a grid four times finer in s
+    /// than the verification grid); else
     /// `base` itself. A replay's first solve then starts on an equilibrium of its own problem.
     pub held: StaticProblem,
     /// How far (units of L) the start shape's contacts are held off the obstacles on the
@@ -371,13 +389,13 @@ fn solve_from(mut p: StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticS
 }
 
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
-/// where it dips into an obstacle between them on the verification grid (by more than the
-/// collision tolerance, 1e-6 L) and the same pose solved with the contacts on the chords
-/// between the points converges clear of the obstacles there, that shape; where that one still
-/// dips (the rod bulges into the obstacle between the points), the pose solved on the chords
-/// held off the obstacles by [`hold_off_margin`] (of the plan's `coincide_tolerance`), when
-/// that converges clear. An end resting on an obstacle is a legal end of a path only when the
-/// verification grid finds it clear. Returned with how its contacts are held: `None` at the
+/// where it dips into an obstacle between them on the end grid `fine` ([`end_grid`]; by more
+/// than the collision tolerance, 1e-6 L) and the same pose solved with the contacts on the
+/// chords between the points converges clear of the obstacles there, that shape; where that one
+/// still dips (the rod bulges into the obstacle between the points), the pose solved on the
+/// chords held off the obstacles by [`hold_off_margin`] (of the plan's `coincide_tolerance`),
+/// when that converges clear. An end resting on an obstacle is a legal end of a path only when
+/// the end grid finds it clear. Returned with how its contacts are held: `None` at the
 /// sample points, `Some(margin)` on the chords, `margin` (units of L) off the obstacles.
 fn on_chords_if_dipping(
     problem: &PlanProblem,
@@ -699,29 +717,40 @@ impl Planner {
                 }
             }
             let l = self.base.model.rod.length;
-            let margin = hold_off_margin(depth, l, self.settings.coincide_tolerance)
-                .filter(|_| !ep.executable && !self.stopped());
-            if let Some(margin) = margin {
+            let tol = self.settings.coincide_tolerance;
+            // Held off by twice the depth; where the shapes still dip, by twice their new depth
+            // more ([`HOLD_OFF_ROUNDS`] times at most, within the same cap in all).
+            let mut margin = hold_off_margin(depth, l, tol);
+            for _ in 0..HOLD_OFF_ROUNDS {
+                let Some(m) = margin.filter(|_| !ep.executable && !self.stopped()) else {
+                    break;
+                };
                 // On top of the margin the start shape already needed.
-                let margin = margin + self.start_contacts.unwrap_or(0.0);
+                let held_by = m + self.start_contacts.unwrap_or(0.0);
                 let (again, held, recorded) =
-                    attempt(&equilibrium_plan::held_off(&self.base, margin));
+                    attempt(&equilibrium_plan::held_off(&self.base, held_by));
                 if held.executable {
                     *ep = equilibrium_plan::EquilibriumPlan {
-                        contact_margin: Some(margin * l),
+                        contact_margin: Some(held_by * l),
                         ..held
                     };
                     rep = again;
                     shapes = recorded;
-                } else if let Some(why) = &held.reason {
+                    break;
+                }
+                if let Some(why) = &held.reason {
                     ep.retry_failed(
                         &format!(
                             "replayed on chords held {:.1e} off the obstacles",
-                            margin * l
+                            held_by * l
                         ),
                         why,
                     );
                 }
+                margin = held
+                    .min_clearance
+                    .filter(|_| held.dips)
+                    .and_then(|c| hold_off_margin(m * l / 2.0 - c, l, tol));
             }
         }
         let executable = !self.stopped()
@@ -798,8 +827,8 @@ impl Planner {
         };
         let (mut start_end, mut goal_end) = (problem.start.clone(), problem.goal.clone());
         resolve(&mut start_end, "start", held.0)?;
-        // The verification grid, on which an end shape resting on an obstacle must be clear.
-        let fine = fine_model(model, settings.verify_s_samples, 4);
+        // The grid on which an end shape resting on an obstacle must be clear.
+        let fine = end_grid(model, settings.verify_s_samples);
         let (start, start_contacts) = end_shape(
             &problem,
             "start",
@@ -887,8 +916,8 @@ impl Planner {
         self.settings.safety(self.base.model.rod.length)
     }
 
-    /// The start and the goal shape's worst clearances to the obstacles on the verification
-    /// grid (`fine`), whatever their sign (none without obstacles).
+    /// The start and the goal shape's worst clearances to the obstacles on the grid `fine`
+    /// (the end grid, [`end_grid`]), whatever their sign (none without obstacles).
     fn end_clearances(&self, fine: &crate::rod::model::Model) -> Vec<EndInside> {
         [("start", &self.start), ("goal", &self.goal)]
             .into_iter()
@@ -904,13 +933,13 @@ impl Planner {
             .collect()
     }
 
-    /// The deepest place where an end shape lies inside an obstacle on the verification grid,
-    /// deeper than the collision tolerance, although its static solve holds it clear at the
-    /// contact points (and on their chords, held off, where it dipped between them): with
-    /// such an end no path is collision-free ([`PlanResult::end_inside_obstacle`]).
+    /// The deepest place where an end shape lies inside an obstacle on a grid four times finer
+    /// in s than the verification grid, deeper than the collision tolerance, although its
+    /// static solve holds it clear at the contact points (and on their chords, held off, where
+    /// it dipped between them): with such an end no path is collision-free ([`PlanResult::end_inside_obstacle`]).
     pub fn end_dip(&self) -> Option<EndInside> {
-        let fine = fine_model(&self.base.model, self.settings.verify_s_samples, 4);
-        self.end_inside_obstacle(&self.end_clearances(&fine))
+        let grid = end_grid(&self.base.model, self.settings.verify_s_samples);
+        self.end_inside_obstacle(&self.end_clearances(&grid))
     }
 
     /// The deepest place among the end shapes' clearances `ends` ([`Self::end_clearances`])
@@ -1189,7 +1218,7 @@ impl Planner {
         // An end inside an obstacle: no path is collision-free, nothing to optimise. Else the
         // straight path when it already attains the lower bound and executes as it stands;
         // else the starts.
-        let ends = self.end_clearances(&fine);
+        let ends = self.end_clearances(&end_grid(model, self.settings.verify_s_samples));
         let end_inside = self.end_inside_obstacle(&ends);
         // The plan is the equilibria along the straight path's trajectory.
         let mut along_straight = false;

@@ -186,8 +186,8 @@ pub struct PlanResult {
     /// safety margin from the obstacles and coincides with its replay
     /// ([`super::PlanSettings::straight_path_first`]); `starts` is then empty.
     pub straight_path_plan: bool,
-    /// An end shape that lies inside an obstacle on the verification grid, deeper than the
-    /// collision tolerance, although its static solve holds it clear at the contact points
+    /// An end shape that lies inside an obstacle on a grid four times finer in s than the
+    /// verification grid, deeper than the collision tolerance, although its static solve holds it clear at the contact points
     /// (and on their chords, then held off the obstacles, tried when it dips): every path
     /// starts or ends there, so none is
     /// collision-free, and the planner does not optimise (`starts` is empty, the replay is not

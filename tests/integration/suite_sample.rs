@@ -686,15 +686,14 @@ fn an_end_bulging_into_an_obstacle_is_held_off_it_and_plans() {
 
 /// The suite's planar problem `planar_23_32` (seed 23), planned with the defaults: with the
 /// case's 32 contact samples its start shape, resting on an obstacle, dips into it between
-/// them on the verification grid (the start pose's solve holds the rod clear only at the
-/// points, also on their chords), so no path from it would be collision-free. The planner is
-/// made again with 64 samples, its end solves started from the shapes that dipped, and says
-/// so. Checked independently: on a grid four times finer in s than the verification grid the
-/// case's own start shape lies more than 1e-4 L inside the obstacle; at the verification
-/// grid's points both of the planner's end shapes are clear to −1e-6 L (between them, on the
-/// finer grid, the start dips 4.3e-6 L, a thousandth of the rod's radius, measured), and the
-/// start holds the same end pose (to 1e-9 L); the plan is executable, its shapes clear to
-/// −1e-6 L on a grid finer in k and s, and the report says the samples used.
+/// them (the start pose's solve holds the rod clear only at the points, also on their chords),
+/// so no path from it would be collision-free. The planner is made again with 64 samples, its
+/// end solves started from the shapes that dipped, and says so. Checked independently: on a
+/// grid four times finer in s than the verification grid the case's own start shape lies more
+/// than 1e-4 L inside the obstacle; on a grid sixteen times finer both of the planner's end
+/// shapes are clear to −1e-6 L, and the start holds the same end pose (to 1e-9 L); the plan
+/// is executable, its shapes clear to −1e-6 L on a grid finer in k and s, and the report
+/// says the samples used.
 #[test]
 fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
     use dlo_planner::planner::observer::Silent;
@@ -716,7 +715,7 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
         (refined.dipped.clearance - depth).abs() <= 1e-3 * l,
         "{refined:?} vs {depth}"
     );
-    let grid = fine_model(&p.base.model, p.settings.verify_s_samples, 2);
+    let grid = fine_model(&p.base.model, 16 * p.settings.verify_s_samples, 2);
     for a in [&p.start.a, &p.goal.a] {
         let c = clearance_on(&p, &grid, a);
         assert!(c >= -1e-6 * l, "{c}");
@@ -738,6 +737,32 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
         assert!(v.min_clearance.expect("obstacles") >= -1e-6 * l);
     } else {
         held_on_the_trajectory_clear_of_obstacles(&p, &r);
+    }
+}
+
+/// The suite's planar problem `planar_71_54` (seed 71): its start shape is pressed against a
+/// capsule next to its tip (a contact force of about 4,400 in the case's units), and the planner
+/// is made with 128 contact samples. The Ritz shape of the start pose solved with the contacts
+/// at those points bulges into the capsule between them, within the verification grid's
+/// spacing; the end shapes are checked on a grid four times finer, and the planner holds that
+/// start on the chords off the capsule. Checked independently: the point-contact solve of the
+/// same pose from the planner's start (the same end position, 1e-9) is more than 2e-5 L inside
+/// the capsule on a grid sixteen times finer in s than the verification grid; both of the
+/// planner's end shapes are clear to −1e-6 L there.
+#[test]
+fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
+    use dlo_planner::planner::verify::fine_model;
+    let (p, points) = resting_start(71, 54, false);
+    let refined = p.contact_refinement.as_ref().expect("more contact samples");
+    assert_eq!(refined.samples, 128);
+    assert!(p.start_contacts.is_some());
+    let l = p.base.model.rod.length;
+    let finer = fine_model(&p.base.model, 16 * p.settings.verify_s_samples, 2);
+    let at_points = clearance_on(&p, &finer, &points.a);
+    assert!(at_points < -2e-5 * l, "{at_points}");
+    for a in [&p.start.a, &p.goal.a] {
+        let c = clearance_on(&p, &finer, a);
+        assert!(c >= -1e-6 * l, "{c}");
     }
 }
 
@@ -1003,8 +1028,8 @@ fn a_refused_pose_says_where_the_solve_searched() {
 /// The suite's planar problems `planar_6_20` and `planar_3_35`, whose start shapes rest on an
 /// obstacle (the second on the chords between its contact points), with the goal set to the
 /// start's own pose: the plan is the straight-line path, which holds the start shape at every
-/// `k` and moves nothing, although its clearance (the resting shape's: 9.7e-10 L, and 3.7e-4 L
-/// held off on the chords) is below the safety margin that a moving path keeps (L/100).
+/// `k` and moves nothing, although its clearance (the resting shapes', held off on the chords:
+/// 3.0e-4 L and 3.7e-4 L) is below the safety margin that a moving path keeps (L/100).
 /// (Before, the optimiser took the end 1.27 L away and back with 2.9 rad of turning, and the
 /// first one's optimal path collided.)
 #[test]
@@ -1038,8 +1063,8 @@ fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
 
 /// The suite's planar problem `planar_6_20`, whose start shape rests on an obstacle, with the
 /// goal 0.01 L and 0.05 L along x from the start's pose: a small move no path can make while
-/// keeping the safety margin next to the start (the straight-line path dips 2.2e-4 L into the
-/// obstacle between the resting shapes). The plan is the equilibria along the straight-line
+/// keeping the safety margin next to the start (the straight-line path comes within 5.1e-5 L
+/// and 2.7e-4 L of the obstacle between the resting shapes, held off it on the chords). The plan is the equilibria along the straight-line
 /// path's trajectory, the rod sliding over the obstacle: executable, peaking within the
 /// energy-gap tolerance (1 %) of the lower bound on U_max, the larger end energy, and the
 /// gripper's path within 1 % of the straight-line distance. (Before, the optimiser ran, did
