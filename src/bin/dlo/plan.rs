@@ -199,7 +199,7 @@ pub(crate) fn run_plan(
                 None => "try an end pose farther from the obstacle".to_string(),
             };
             eprintln!(
-                "error: {}: no collision-free plan: the {} shape itself comes {:.3e} inside obstacle {} at s = {:.4} (between the contact points its static solve holds clear{tried}), so no path from it is collision-free on the verification grid; {advice}",
+                "error: {}: no collision-free plan: the {} shape itself comes {:.3e} inside obstacle {} at s = {:.4} (between the contact points its static solve holds clear{tried}), so no path from it is collision-free; {advice}",
                 path.display(),
                 e.end,
                 -e.clearance,
