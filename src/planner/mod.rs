@@ -198,6 +198,9 @@ pub struct Planner {
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
+    /// The grid the end shapes were checked on ([`end_grid`]), with the `verify_s_samples` it
+    /// was made for.
+    end_grid: Arc<(usize, crate::rod::model::Model)>,
 }
 
 /// Smallest surface gap to any obstacle (case units) of boundary positions `x/L`.
@@ -875,6 +878,7 @@ impl Planner {
             timed_out: Arc::new(AtomicBool::new(false)),
             quick: false,
             workers: workers::Workers::new(settings.threads()),
+            end_grid: Arc::new((settings.verify_s_samples, fine)),
             settings,
         })
     }
@@ -938,8 +942,18 @@ impl Planner {
     /// static solve holds it clear at the contact points (and on their chords, held off, where
     /// it dipped between them): with such an end no path is collision-free ([`PlanResult::end_inside_obstacle`]).
     pub fn end_dip(&self) -> Option<EndInside> {
-        let grid = end_grid(&self.base.model, self.settings.verify_s_samples);
-        self.end_inside_obstacle(&self.end_clearances(&grid))
+        self.end_inside_obstacle(&self.end_clearances(&self.end_check_grid().1))
+    }
+
+    /// The grid the end shapes are checked on: the one the planner was made with, or where
+    /// `verify_s_samples` has changed since, one made for it ([`end_grid`]).
+    fn end_check_grid(&self) -> Arc<(usize, crate::rod::model::Model)> {
+        let n = self.settings.verify_s_samples;
+        if self.end_grid.0 == n {
+            self.end_grid.clone()
+        } else {
+            Arc::new((n, end_grid(&self.base.model, n)))
+        }
     }
 
     /// The deepest place among the end shapes' clearances `ends` ([`Self::end_clearances`])
@@ -1218,7 +1232,7 @@ impl Planner {
         // An end inside an obstacle: no path is collision-free, nothing to optimise. Else the
         // straight path when it already attains the lower bound and executes as it stands;
         // else the starts.
-        let ends = self.end_clearances(&end_grid(model, self.settings.verify_s_samples));
+        let ends = self.end_clearances(&self.end_check_grid().1);
         let end_inside = self.end_inside_obstacle(&ends);
         // The plan is the equilibria along the straight path's trajectory.
         let mut along_straight = false;
