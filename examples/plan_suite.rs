@@ -25,7 +25,7 @@
 //! replay, whether the replay snaps, the plan time (end solves, plan, verification and
 //! replay), the gripper's path length over the straight-line distance between its ends, and an
 //! independent clearance check of every plan called collision-free on a grid twice as fine in
-//! k as the verification's, at the model's own boundary points, and of every plan executable
+//! k as the verification's and four times as fine in s, and of every plan executable
 //! by its replayed equilibria at each replayed shape on a grid four times finer in s (the
 //! worst of these is the "worst false collision-free" of the table: it must be ≥ −1e-6 L).
 
@@ -290,10 +290,11 @@ pub struct Outcome {
     pub attempts: String,
 }
 
-/// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k at the
-/// model's boundary points (units of L), and where in k.
+/// The plan's smallest clearance to any obstacle on `2 (verify_k − 1) + 1` values of k, each
+/// shape at `4 verify_s + 1` points in s (both grids twice or four times the verification
+/// grid's; units of L), and where in k.
 fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
-    let model = &p.base.model;
+    let model = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
     let path = p.with_terms(r.path_terms).path();
     let n = 2 * (p.settings.verify_k_samples - 1);
     let mut a = vec![0.0; path.n()];

@@ -21,7 +21,7 @@ fn sample(generate: fn(&mut Rng, usize) -> String, kind: &str, indices: &[usize]
 }
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
-/// in k finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
+/// in k and four times as fine in s as the verification grid finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
 /// is called coinciding. The sample: the planar problems `planar_0`, `planar_2` and `planar_3`
 /// (`planar_1`, whose start shape the first solve misses, has its own test below) and the
 /// first 3D problem, which must keep
