@@ -354,11 +354,10 @@ const CONTACT_DOUBLINGS: u32 = 2;
 /// ([`Planner::new`](crate::planner::Planner::new)). Where an end shape dips into an obstacle
 /// between the contact points its solve holds clear, on a grid four times finer in s than the
 /// verification grid ([`crate::planner::Planner::end_dip`]: a rod wrapped round an obstacle
-/// whose radius is not
-/// much larger than the points' spacing), the case's problem is made again with twice the
-/// contact samples (`discretisation.samples`), and again with four times (with self-contact,
-/// whose rows grow as the samples squared, twice only), within their limits, its end solves
-/// started from the shapes solved before. The first whose end shapes
+/// whose radius is not much larger than the points' spacing), the case's problem is made
+/// again with twice the contact samples (`discretisation.samples`), and again with four times
+/// (with self-contact, whose rows grow as the samples squared, twice only), within their
+/// limits, its end solves started from the shapes solved before. The first whose end shapes
 /// rest clear on that grid is the planner, and says so
 /// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
 /// plan then reports the end inside the obstacle). Either way the planner lists the tries

@@ -168,8 +168,8 @@ pub struct Planner {
     /// contacts on the chords between the sample points, [`Planner::start_contacts`] off the
     /// obstacles, where the start shape needed that to rest on an obstacle clear of it (its
     /// contacts at the points dipped into it between them on a grid four times finer in s
-    /// than the verification grid); else
-    /// `base` itself. A replay's first solve then starts on an equilibrium of its own problem.
+    /// than the verification grid); else `base` itself. A replay's first solve then starts on
+    /// an equilibrium of its own problem.
     pub held: StaticProblem,
     /// How far (units of L) the start shape's contacts are held off the obstacles on the
     /// chords between the sample points, where it needed the chords; `None` where it rests on
@@ -940,7 +940,8 @@ impl Planner {
     /// The deepest place where an end shape lies inside an obstacle on a grid four times finer
     /// in s than the verification grid, deeper than the collision tolerance, although its
     /// static solve holds it clear at the contact points (and on their chords, held off, where
-    /// it dipped between them): with such an end no path is collision-free ([`PlanResult::end_inside_obstacle`]).
+    /// it dipped between them): with such an end no path is collision-free
+    /// ([`PlanResult::end_inside_obstacle`]).
     pub fn end_dip(&self) -> Option<EndInside> {
         self.end_inside_obstacle(&self.end_clearances(&self.end_check_grid().1))
     }
