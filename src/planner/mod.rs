@@ -720,10 +720,10 @@ impl Planner {
                 }
             }
             let l = self.base.model.rod.length;
-            let tol = self.settings.coincide_tolerance;
+            let coincide = self.settings.coincide_tolerance;
             // Held off by twice the depth; where the shapes still dip, by twice their new depth
             // more ([`HOLD_OFF_ROUNDS`] times at most, within the same cap in all).
-            let mut margin = hold_off_margin(depth, l, tol);
+            let mut margin = hold_off_margin(depth, l, coincide);
             for _ in 0..HOLD_OFF_ROUNDS {
                 let Some(m) = margin.filter(|_| !ep.executable && !self.stopped()) else {
                     break;
@@ -753,7 +753,7 @@ impl Planner {
                 margin = held
                     .min_clearance
                     .filter(|_| held.dips)
-                    .and_then(|c| hold_off_margin(m * l / 2.0 - c, l, tol));
+                    .and_then(|c| hold_off_margin(m * l / 2.0 - c, l, coincide));
             }
         }
         let executable = !self.stopped()
@@ -920,9 +920,11 @@ impl Planner {
         self.settings.safety(self.base.model.rod.length)
     }
 
-    /// The start and the goal shape's worst clearances to the obstacles on the grid `fine`
-    /// (the end grid, [`end_grid`]), whatever their sign (none without obstacles).
-    fn end_clearances(&self, fine: &crate::rod::model::Model) -> Vec<EndInside> {
+    /// The start and the goal shape's worst clearances to the obstacles on the end grid
+    /// ([`Self::end_check_grid`]), whatever their sign (none without obstacles).
+    fn end_clearances(&self) -> Vec<EndInside> {
+        let grid = self.end_check_grid();
+        let fine = &grid.1;
         [("start", &self.start), ("goal", &self.goal)]
             .into_iter()
             .filter_map(|(end, sol)| {
@@ -943,7 +945,7 @@ impl Planner {
     /// it dipped between them): with such an end no path is collision-free
     /// ([`PlanResult::end_inside_obstacle`]).
     pub fn end_dip(&self) -> Option<EndInside> {
-        self.end_inside_obstacle(&self.end_clearances(&self.end_check_grid().1))
+        self.end_inside_obstacle(&self.end_clearances())
     }
 
     /// The grid the end shapes are checked on: the one the planner was made with, or where
@@ -1233,7 +1235,7 @@ impl Planner {
         // An end inside an obstacle: no path is collision-free, nothing to optimise. Else the
         // straight path when it already attains the lower bound and executes as it stands;
         // else the starts.
-        let ends = self.end_clearances(&self.end_check_grid().1);
+        let ends = self.end_clearances();
         let end_inside = self.end_inside_obstacle(&ends);
         // The plan is the equilibria along the straight path's trajectory.
         let mut along_straight = false;

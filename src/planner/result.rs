@@ -187,9 +187,9 @@ pub struct PlanResult {
     /// ([`super::PlanSettings::straight_path_first`]); `starts` is then empty.
     pub straight_path_plan: bool,
     /// An end shape that lies inside an obstacle on a grid four times finer in s than the
-    /// verification grid, deeper than the collision tolerance, although its static solve holds it clear at the contact points
-    /// (and on their chords, then held off the obstacles, tried when it dips): every path
-    /// starts or ends there, so none is
+    /// verification grid, deeper than the collision tolerance, although its static solve holds
+    /// it clear at the contact points (and on their chords, then held off the obstacles, tried
+    /// when it dips): every path starts or ends there, so none is
     /// collision-free, and the planner does not optimise (`starts` is empty, the replay is not
     /// run, the status is `collision`).
     pub end_inside_obstacle: Option<EndInside>,

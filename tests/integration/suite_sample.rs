@@ -21,8 +21,8 @@ fn sample(generate: fn(&mut Rng, usize) -> String, kind: &str, indices: &[usize]
 }
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
-/// in k and four times as fine in s as the verification grid finds no penetration; no replay that departs by more than the 2 % tolerance, or snaps,
-/// is called coinciding. The sample: the planar problems `planar_0`, `planar_2` and `planar_3`
+/// in k and four times as fine in s as the verification grid finds no penetration; no replay
+/// that departs by more than the 2 % tolerance, or snaps, is called coinciding. The sample: the planar problems `planar_0`, `planar_2` and `planar_3`
 /// (`planar_1`, whose start shape the first solve misses, has its own test below) and the
 /// first 3D problem, which must keep
 /// coinciding with their replays
@@ -1064,8 +1064,8 @@ fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
 /// The suite's planar problem `planar_6_20`, whose start shape rests on an obstacle, with the
 /// goal 0.01 L and 0.05 L along x from the start's pose: a small move no path can make while
 /// keeping the safety margin next to the start (the straight-line path comes within 5.1e-5 L
-/// and 2.7e-4 L of the obstacle between the resting shapes, held off it on the chords). The plan is the equilibria along the straight-line
-/// path's trajectory, the rod sliding over the obstacle: executable, peaking within the
+/// and 2.7e-4 L of the obstacle between the resting shapes, held off it on the chords). The
+/// plan is the equilibria along the straight-line path's trajectory, the rod sliding over the obstacle: executable, peaking within the
 /// energy-gap tolerance (1 %) of the lower bound on U_max, the larger end energy, and the
 /// gripper's path within 1 % of the straight-line distance. (Before, the optimiser ran, did
 /// not converge, and the plan, its path's replayed equilibria, took the end 1.93 L and 2.09 L
