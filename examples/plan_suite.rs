@@ -571,7 +571,7 @@ fn main() {
                 Some(o) => {
                     if verbose {
                         eprintln!(
-                            "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {:+.2e} at k = {:.4} replay clearance {:+.2e} converged {} stable {} attempts {}",
+                            "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {} replay clearance {:+.2e} converged {} stable {} attempts {}",
                             o.name,
                             o.planned,
                             o.coincide,
@@ -581,8 +581,12 @@ fn main() {
                             o.deviation,
                             o.travel,
                             o.seconds,
-                            o.checked_clearance.map_or(f64::NAN, |c| c.0),
-                            o.checked_clearance.map_or(f64::NAN, |c| c.1),
+                            // Only plans called collision-free (or executable by their
+                            // replayed equilibria) are checked.
+                            o.checked_clearance
+                                .map_or("unchecked".to_string(), |(d, k)| {
+                                    format!("{d:+.2e} at k = {k:.4}")
+                                }),
                             o.replay.0,
                             o.replay.1,
                             o.replay.2,
