@@ -371,6 +371,7 @@ pub fn planner(
     use crate::planner::{ContactRefinement, ContactTry, Planner};
     let mut own = Planner::new(problem.clone(), settings.clone())?;
     let Some(dipped) = own.end_dip() else {
+        own.finer_contacts = finer_contacts(case, &own, case.builder.sample_count());
         return Ok(own);
     };
     let case_samples = case.builder.sample_count();
@@ -401,6 +402,7 @@ pub fn planner(
         };
         match p.end_dip() {
             None => {
+                p.finer_contacts = finer_contacts(case, &p, n);
                 p.contact_refinement = Some(ContactRefinement {
                     case_samples,
                     samples: n,
@@ -418,5 +420,28 @@ pub fn planner(
         seeded.goal.shape = Some(p.goal.a.clone());
     }
     own.contact_tries = tries;
+    own.finer_contacts = finer_contacts(case, &own, case_samples);
     Ok(own)
+}
+
+/// `case`'s static problem with twice `samples` contact samples, for `planner`'s replayed
+/// equilibria that dip between the chords of its own
+/// ([`crate::planner::Planner::finer_contacts`]); `None` where that is beyond the limits
+/// (with self-contact, whose rows grow as the samples squared, its own limit), or where the
+/// case has no obstacle.
+fn finer_contacts(
+    case: &Case,
+    planner: &crate::planner::Planner,
+    samples: usize,
+) -> Option<std::sync::Arc<(usize, crate::statics::StaticProblem)>> {
+    let most = if planner.has_self_contact() {
+        super::limits::MAX_SELF_CONTACT_SAMPLES
+    } else {
+        crate::rod::model::MAX_SAMPLES
+    };
+    let n = 2 * samples;
+    (!planner.obstacles.is_empty() && n <= most)
+        .then(|| case.builder.clone().samples(n).build().ok())
+        .flatten()
+        .map(|p| std::sync::Arc::new((n, p)))
 }

@@ -64,6 +64,11 @@ pub struct EquilibriumPlan {
     /// points (absent: not held off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_margin: Option<f64>,
+    /// The contact samples (intervals between sample points) the replay's solves held the
+    /// contacts at, where twice the case's: shapes that still dipped between the chords of
+    /// the case's sample points were replayed on the chords of these (absent: the case's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_samples: Option<usize>,
     /// Whose end poses the gripper follows: `"optimal_path"` (the optimal path's, as the
     /// replay) or `"straight_path"` (the straight-line path's, tried when no optimised path is
     /// executable, neither as it stands nor by its equilibria).
@@ -248,6 +253,7 @@ impl Planner {
                 "points"
             },
             contact_margin: None,
+            contact_samples: None,
             trajectory: "optimal_path",
             optimal_path_not_executable: None,
             dips: false,

@@ -183,6 +183,12 @@ pub struct Planner {
     /// solve (set by [`crate::case::plan::planner`]; reported as
     /// [`PlanResult::contact_samples_tried`]).
     pub contact_tries: Vec<ContactTry>,
+    /// The count of contact samples (intervals) and `base` with them, twice `base`'s (set by
+    /// [`crate::case::plan::planner`]; `None` where the limits leave no room): where no plan
+    /// of the search is executable and replayed equilibria still dip into an obstacle between
+    /// the chords of `base`'s sample points, they are replayed again on the chords of these,
+    /// whose dips are about a quarter as deep.
+    pub finer_contacts: Option<Arc<(usize, StaticProblem)>>,
     /// Set to stop a run (see [`Planner::stop_handle`]).
     stop: Arc<AtomicBool>,
     /// Objective evaluations each start may use (`None`: no limit); set on the attempts after
@@ -195,6 +201,9 @@ pub struct Planner {
     timed_out: Arc<AtomicBool>,
     /// The quick first attempt of a planar rod ([`Attempt::Quick`]).
     quick: bool,
+    /// Judgements replay equilibria that still dip on [`Planner::finer_contacts`]: set on the
+    /// copy that judges the chosen plan again where no plan was executable.
+    finer_retry: bool,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
@@ -690,70 +699,115 @@ impl Planner {
         // Equilibria that dip between the solves' contact points: replayed again with the
         // contacts on the chords between them, and where they still dip, held off the obstacles
         // by twice the depth (at most a twentieth of the coincidence tolerance, so that the
-        // shapes stay well within it of the equilibria on the obstacles themselves).
+        // shapes stay well within it of the equilibria on the obstacles themselves). Where they
+        // still dip after that, on the copy that judges plans again when nothing was executable
+        // (`finer_retry`), the same on twice the contact samples, whose chords dip about a
+        // quarter as deep, from the start pose solved there.
         if let Some(ep) = equilibrium_plan
             .as_mut()
             .filter(|e| e.dips && !self.stopped())
         {
-            let mut attempt = |held: &StaticProblem| {
-                let mut rec = Recorder::new(observer);
-                let again = self.replay_under(held, path, z, EarlyStop::Unconverged, &mut rec);
-                let plan = self.equilibrium_plan(held, path, z, &again, fine, &mut rec);
-                (again, plan, rec.into_shapes())
-            };
-            let mut depth = ep.min_clearance.map_or(0.0, |c| -c);
-            if let Some(chords) = equilibrium_plan::on_chords(&self.held) {
-                let (again, on_chords, recorded) = attempt(&chords);
-                if on_chords.executable {
-                    *ep = on_chords;
-                    rep = again;
-                    shapes = recorded;
-                } else {
-                    if let Some(why) = &on_chords.reason {
-                        ep.retry_failed("replayed with contacts on chords", why);
-                    }
-                    depth = if on_chords.dips {
-                        on_chords.min_clearance.map_or(0.0, |c| -c)
-                    } else {
-                        0.0
-                    };
-                }
-            }
             let l = self.base.model.rod.length;
             let coincide = self.settings.coincide_tolerance;
-            // Held off by twice the depth; where the shapes still dip, by twice their new depth
-            // more ([`HOLD_OFF_ROUNDS`] times at most, within the same cap in all).
-            let mut margin = hold_off_margin(depth, l, coincide);
-            for _ in 0..HOLD_OFF_ROUNDS {
-                let Some(m) = margin.filter(|_| !ep.executable && !self.stopped()) else {
-                    break;
-                };
-                // On top of the margin the start shape already needed.
-                let held_by = m + self.start_contacts.unwrap_or(0.0);
-                let (again, held, recorded) =
-                    attempt(&equilibrium_plan::held_off(&self.base, held_by));
-                if held.executable {
+            let start_margin = self.start_contacts.unwrap_or(0.0);
+            // Replays the shapes under `held` (off the obstacles by `margin`, units of L, on
+            // `samples` contact samples where not the case's); where they are a plan, it is
+            // this one. Returns how deep they dip between contact points (0 where they do not).
+            let mut run = |pl: &Planner,
+                           held: &StaticProblem,
+                           what: &str,
+                           margin: f64,
+                           samples: Option<usize>,
+                           ep: &mut equilibrium_plan::EquilibriumPlan,
+                           rep: &mut Replay,
+                           shapes: &mut RecordedShapes| {
+                let mut rec = Recorder::new(observer);
+                let again = pl.replay_under(held, path, z, EarlyStop::Unconverged, &mut rec);
+                let plan = pl.equilibrium_plan(held, path, z, &again, fine, &mut rec);
+                if plan.executable {
                     *ep = equilibrium_plan::EquilibriumPlan {
-                        contact_margin: Some(held_by * l),
-                        ..held
+                        contact_margin: (margin > 0.0).then_some(margin * l),
+                        contact_samples: samples,
+                        ..plan
                     };
-                    rep = again;
-                    shapes = recorded;
+                    *rep = again;
+                    *shapes = rec.into_shapes();
+                    return 0.0;
+                }
+                if let Some(why) = &plan.reason {
+                    ep.retry_failed(what, why);
+                }
+                match plan.min_clearance {
+                    Some(c) if plan.dips => -c,
+                    _ => 0.0,
+                }
+            };
+            let mut depth = ep.min_clearance.map_or(0.0, |c| -c);
+            for level in 0..2 {
+                if ep.executable || depth <= 0.0 || self.stopped() {
                     break;
                 }
-                if let Some(why) = &held.reason {
-                    ep.retry_failed(
-                        &format!(
-                            "replayed on chords held {:.1e} off the obstacles",
-                            held_by * l
-                        ),
-                        why,
-                    );
+                // The planner (its start shape solved there), the problem without the end, its
+                // chords (`None`: the replay above held them already), and its contact samples
+                // where not the case's.
+                let (pl, base, chords, samples) = if level == 0 {
+                    let chords = equilibrium_plan::on_chords(&self.held);
+                    (std::borrow::Cow::Borrowed(self), &self.base, chords, None)
+                } else {
+                    let Some((n, finer)) =
+                        self.finer_contacts.as_deref().filter(|_| self.finer_retry)
+                    else {
+                        break;
+                    };
+                    let held = equilibrium_plan::held_off(finer, start_margin);
+                    let what =
+                        format!("replayed with contacts on the chords of {n} contact samples");
+                    let Some(start) = replay::start_under(&held, &self.start, &self.static_options)
+                    else {
+                        ep.retry_failed(&what, "the start pose's solve did not converge");
+                        break;
+                    };
+                    let mut pl = self.clone();
+                    pl.start = start;
+                    (std::borrow::Cow::Owned(pl), finer, Some(held), Some(*n))
+                };
+                // (The case's samples' as the reports have always put them.)
+                let on = samples.map_or("chords".to_string(), |n| {
+                    format!("the chords of {n} contact samples")
+                });
+                if let Some(chords) = chords {
+                    let what = format!("replayed with contacts on {on}");
+                    let (m, s) = (start_margin, samples);
+                    depth = run(&pl, &chords, &what, m, s, ep, &mut rep, &mut shapes);
                 }
-                margin = held
-                    .min_clearance
-                    .filter(|_| held.dips)
-                    .and_then(|c| hold_off_margin(m * l / 2.0 - c, l, coincide));
+                // Held off by twice the depth; where the shapes still dip, by twice their new
+                // depth more ([`HOLD_OFF_ROUNDS`] times at most, within the same cap in all).
+                let mut margin = hold_off_margin(depth, l, coincide);
+                for _ in 0..HOLD_OFF_ROUNDS {
+                    let Some(m) = margin.filter(|_| !ep.executable && !self.stopped()) else {
+                        break;
+                    };
+                    // On top of the margin the start shape already needed.
+                    let held_by = m + start_margin;
+                    let held = equilibrium_plan::held_off(base, held_by);
+                    let what = format!(
+                        "replayed on {on} held {:.1e} off the obstacles",
+                        held_by * l
+                    );
+                    depth = run(
+                        &pl,
+                        &held,
+                        &what,
+                        held_by,
+                        samples,
+                        ep,
+                        &mut rep,
+                        &mut shapes,
+                    );
+                    margin = (depth > 0.0)
+                        .then(|| hold_off_margin(m * l / 2.0 + depth, l, coincide))
+                        .flatten();
+                }
             }
         }
         let executable = !self.stopped()
@@ -866,6 +920,7 @@ impl Planner {
             start_contacts,
             contact_refinement: None,
             contact_tries: Vec::new(),
+            finer_contacts: None,
             base: problem.statics,
             obstacles: problem.obstacles,
             static_options,
@@ -877,6 +932,7 @@ impl Planner {
             deadline: None,
             timed_out: Arc::new(AtomicBool::new(false)),
             quick: false,
+            finer_retry: false,
             workers: workers::Workers::new(settings.threads()),
             end_grid: Arc::new((settings.verify_s_samples, fine)),
             settings,
@@ -1140,6 +1196,33 @@ impl Planner {
             }
         };
         let runs = self.run_starts(fine, observer, &mut judge);
+        // Nothing executable: the plans judged whose replayed equilibria dipped between contact
+        // points, best first, judged again with twice the contact samples where they still dip
+        // after the case's, until one is executable. (Last, so that no plan the search found
+        // is traded for one of these.)
+        if self.finer_contacts.is_some() && !judged.iter().any(|(_, j)| j.executable) {
+            let mut order: Vec<usize> = (0..judged.len())
+                .filter(|&n| {
+                    let j = &judged[n].1;
+                    j.replay.start_held() && j.equilibrium_plan.as_ref().is_some_and(|e| e.dips)
+                })
+                .collect();
+            order.sort_by(|&a, &b| self.ranked(&runs, judged[b].0, judged[a].0));
+            let finer = Planner {
+                finer_retry: true,
+                ..self.clone()
+            };
+            for n in order {
+                if self.stopped() {
+                    break;
+                }
+                let again = finer.judge(&runs[judged[n].0], fine, observer);
+                if again.executable {
+                    judged[n].1 = again;
+                    break;
+                }
+            }
+        }
         // The best executable plan judged, else the best plan.
         let best = judged
             .iter()

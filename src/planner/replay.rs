@@ -199,6 +199,24 @@ fn solve_held(
     }
 }
 
+/// The end pose of `start` solved under `base`, a problem whose contact rows are not those
+/// `start` was solved with (more sample points): from `start`'s shape, the multipliers from
+/// zero, once more with a stiffer penalty where that does not converge; `None` where neither
+/// does.
+pub(super) fn start_under(
+    base: &StaticProblem,
+    start: &StaticSolution,
+    opts: &StaticOptions,
+) -> Option<StaticSolution> {
+    let positions = base.model.evaluate(&start.a).positions;
+    let from = StaticSolution {
+        lambda: Vec::new(),
+        ..start.clone()
+    };
+    let (_, sol) = solve_held(base, &from, &start.a, &positions, opts, true);
+    (sol.status == SolveStatus::Converged).then_some(sol)
+}
+
 /// Total normal force (case units) the obstacles of `base` exert on a solution of a problem
 /// whose first rows are `base`'s: the sum of those obstacle rows' multipliers.
 fn contact_force(base: &StaticProblem, sol: &StaticSolution) -> f64 {

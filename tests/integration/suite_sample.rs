@@ -2,7 +2,7 @@
 //! every setting at its default: problems of the planar and of the 3D generator, each started
 //! from seed 1, named by their place in its sequence.
 
-use crate::suite::{Outcome, Rng, planar_problem, run, spatial_problem};
+use crate::suite::{Outcome, Rng, hanging_problem, planar_problem, run, spatial_problem};
 
 /// Problems `indices` (increasing) of `generate` (seed 1), planned; each must have static start
 /// and goal shapes.
@@ -764,6 +764,57 @@ fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
         let c = clearance_on(&p, &finer, a);
         assert!(c >= -1e-6 * l, "{c}");
     }
+}
+
+/// The hanging family's problem `hanging_1_58` (seed 1, `plan_suite --family hanging`),
+/// planned with the defaults: a heavy strip whose optimal path departs from its replay, and
+/// whose replayed equilibria dip into an obstacle between the case's 32 contact points, and
+/// again between their chords by more than the largest hold-off allows (twice the depth must
+/// stay within a twentieth of the coincidence tolerance); no plan of the search is
+/// executable. Judged again, on the chords of 64 contact samples, from the start pose solved
+/// there, they dip about a quarter as deep, and held off by twice that they are the plan. Checked independently: every replayed shape is clear to
+/// −1e-6 L on a grid four times finer in s than its own boundary points.
+#[test]
+fn equilibria_dipping_between_chords_are_replayed_on_twice_the_contact_samples() {
+    use dlo_planner::planner::observer::Silent;
+    use dlo_planner::planner::verify::fine_model;
+    let mut rng = Rng(1);
+    let text = (0..=58)
+        .map(|j| hanging_problem(&mut rng, j))
+        .last()
+        .expect("a problem");
+    let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/hanging.json"))
+        .expect("a generated case");
+    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    assert!(p.contact_refinement.is_none());
+    assert_eq!(p.finer_contacts.as_ref().map(|f| f.0), Some(64));
+    let r = p.run(&mut Silent);
+    assert!(!r.replay.coincide);
+    let ep = r.equilibrium_plan.as_ref().expect("the equilibria judged");
+    assert!(ep.executable, "{:?}", ep.reason);
+    assert_eq!(ep.contact_samples, Some(64));
+    assert_eq!(ep.contact, "chords");
+    let l = p.base.model.rod.length;
+    let margin = ep.contact_margin.expect("held off");
+    assert!(
+        margin > 0.0 && margin <= 0.05 * p.settings.coincide_tolerance * l,
+        "{margin}"
+    );
+    assert!(r.verdict().is_executable());
+    let first = r.replay.steps.first().expect("steps");
+    assert_eq!(
+        first.positions.len(),
+        65,
+        "replayed on the finer problem's points"
+    );
+    let fine = fine_model(&p.base.model, 4 * (first.positions.len() - 1), 2);
+    let worst = r
+        .replay
+        .steps
+        .iter()
+        .map(|step| clearance_on(&p, &fine, &step.a))
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
 }
 
 /// The suite's 3D problem `spatial_46_17` (seed 46, which draws 62 planar problems before its

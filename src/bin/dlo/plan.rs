@@ -639,10 +639,17 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             },
             e.u_max,
             e.k_at_u_max,
-            match (e.contact_margin, e.contact) {
-                (Some(m), _) => format!("; contacts on chords, held {m:.2e} off the obstacles"),
-                (None, "chords") => "; contacts on chords".to_string(),
-                _ => String::new(),
+            {
+                let chords = e.contact_samples.map_or("chords".to_string(), |n| {
+                    format!("the chords of {n} contact samples")
+                });
+                match (e.contact_margin, e.contact) {
+                    (Some(m), _) => {
+                        format!("; contacts on {chords}, held {m:.2e} off the obstacles")
+                    }
+                    (None, "chords") => format!("; contacts on {chords}"),
+                    _ => String::new(),
+                }
             },
             match (e.confirmation_steps, e.confirmation_deviation_over_l) {
                 (Some(n), Some(d)) =>
