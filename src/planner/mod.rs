@@ -1213,7 +1213,8 @@ impl Planner {
                 ..self.clone()
             };
             for n in order {
-                if self.stopped() {
+                // (Past a time limit nothing new starts.)
+                if self.stopped() || self.time_up() {
                     break;
                 }
                 let again = finer.judge(&runs[judged[n].0], fine, observer);
