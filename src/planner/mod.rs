@@ -202,7 +202,7 @@ pub struct Planner {
     /// The quick first attempt of a planar rod ([`Attempt::Quick`]).
     quick: bool,
     /// Judgements replay equilibria that still dip on [`Planner::finer_contacts`]: set on the
-    /// copy that judges the chosen plan again where no plan was executable.
+    /// copy that judges the search's plans again where none was executable.
     finer_retry: bool,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
