@@ -772,8 +772,9 @@ fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
 /// again between their chords by more than the largest hold-off allows (twice the depth must
 /// stay within a twentieth of the coincidence tolerance); no plan of the search is
 /// executable. Judged again, on the chords of 64 contact samples, from the start pose solved
-/// there, they dip about a quarter as deep, and held off by twice that they are the plan. Checked independently: every replayed shape is clear to
-/// −1e-6 L on a grid four times finer in s than its own boundary points.
+/// there, they dip about a quarter as deep, and held off by twice that they are the plan.
+/// Checked independently: every replayed shape is clear to −1e-6 L on a grid four times finer
+/// in s than its own boundary points.
 #[test]
 fn equilibria_dipping_between_chords_are_replayed_on_twice_the_contact_samples() {
     use dlo_planner::planner::observer::Silent;
