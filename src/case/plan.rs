@@ -376,10 +376,11 @@ pub fn planner(
     };
     let case_samples = case.builder.sample_count();
     // Self-contact rows grow as the samples squared: one doubling only.
-    let (most, doublings) = if own.has_self_contact() {
-        (super::limits::MAX_SELF_CONTACT_SAMPLES, 1)
+    let most = most_samples(&own);
+    let doublings = if own.has_self_contact() {
+        1
     } else {
-        (crate::rod::model::MAX_SAMPLES, CONTACT_DOUBLINGS)
+        CONTACT_DOUBLINGS
     };
     let mut seeded = problem;
     seeded.start.shape = Some(own.start.a.clone());
@@ -434,14 +435,19 @@ fn finer_contacts(
     planner: &crate::planner::Planner,
     samples: usize,
 ) -> Option<std::sync::Arc<(usize, crate::statics::StaticProblem)>> {
-    let most = if planner.has_self_contact() {
-        super::limits::MAX_SELF_CONTACT_SAMPLES
-    } else {
-        crate::rod::model::MAX_SAMPLES
-    };
     let n = 2 * samples;
-    (!planner.obstacles.is_empty() && n <= most)
+    (!planner.obstacles.is_empty() && n <= most_samples(planner))
         .then(|| case.builder.clone().samples(n).build().ok())
         .flatten()
         .map(|p| std::sync::Arc::new((n, p)))
+}
+
+/// The most contact samples `planner`'s case may be made with: with self-contact, whose rows
+/// grow as the samples squared, fewer.
+fn most_samples(planner: &crate::planner::Planner) -> usize {
+    if planner.has_self_contact() {
+        super::limits::MAX_SELF_CONTACT_SAMPLES
+    } else {
+        crate::rod::model::MAX_SAMPLES
+    }
 }

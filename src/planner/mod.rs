@@ -584,6 +584,10 @@ struct Judged {
     /// The optimal path coincides with its replay (collision-free and converged), or the
     /// replayed equilibria are a plan.
     executable: bool,
+    /// The replayed equilibria still dipped between contact points when the retries on the
+    /// case's contact samples (chords, held off) had failed: those on twice the samples
+    /// ([`Planner::finer_contacts`]) may pass.
+    dips_on_case_samples: bool,
 }
 
 impl Judged {
@@ -596,6 +600,7 @@ impl Judged {
             shapes: RecordedShapes::default(),
             seconds: 0.0,
             executable: false,
+            dips_on_case_samples: false,
         }
     }
 }
@@ -696,12 +701,14 @@ impl Planner {
             ep.contact_margin = self.start_contacts.filter(|&m| m > 0.0).map(|m| m * l);
         }
         let mut shapes = rec.into_shapes();
+        let mut dips_on_case_samples = false;
         // Equilibria that dip between the solves' contact points: replayed again with the
         // contacts on the chords between them, and where they still dip, held off the obstacles
         // by twice the depth (at most a twentieth of the coincidence tolerance, so that the
         // shapes stay well within it of the equilibria on the obstacles themselves). Where they
         // still dip after that, on the copy that judges plans again when nothing was executable
-        // (`finer_retry`), the same on twice the contact samples, whose chords dip about a
+        // (`finer_retry`, which goes straight there: the case's retries ran and failed as they
+        // did the first time), the same on twice the contact samples, whose chords dip about a
         // quarter as deep, from the start pose solved there.
         if let Some(ep) = equilibrium_plan
             .as_mut()
@@ -743,9 +750,12 @@ impl Planner {
                 }
             };
             let mut depth = ep.min_clearance.map_or(0.0, |c| -c);
-            for level in 0..2 {
+            for level in usize::from(self.finer_retry)..2 {
                 if ep.executable || depth <= 0.0 || self.stopped() {
                     break;
+                }
+                if level == 1 {
+                    dips_on_case_samples = true;
                 }
                 // The planner (its start shape solved there), the problem without the end, its
                 // chords (`None`: the replay above held them already), and its contact samples
@@ -820,6 +830,7 @@ impl Planner {
             shapes,
             seconds: t.elapsed().as_secs_f64(),
             executable,
+            dips_on_case_samples,
         }
     }
 }
@@ -1196,16 +1207,13 @@ impl Planner {
             }
         };
         let runs = self.run_starts(fine, observer, &mut judge);
-        // Nothing executable: the plans judged whose replayed equilibria dipped between contact
-        // points, best first, judged again with twice the contact samples where they still dip
-        // after the case's, until one is executable. (Last, so that no plan the search found
+        // Nothing executable: the plans judged whose replayed equilibria still dipped between
+        // contact points after the retries on the case's, best first, judged again with twice
+        // the contact samples, until one is executable. (Last, so that no plan the search found
         // is traded for one of these.)
         if self.finer_contacts.is_some() && !judged.iter().any(|(_, j)| j.executable) {
             let mut order: Vec<usize> = (0..judged.len())
-                .filter(|&n| {
-                    let j = &judged[n].1;
-                    j.replay.start_held() && j.equilibrium_plan.as_ref().is_some_and(|e| e.dips)
-                })
+                .filter(|&n| judged[n].1.dips_on_case_samples)
                 .collect();
             order.sort_by(|&a, &b| self.ranked(&runs, judged[b].0, judged[a].0));
             let finer = Planner {

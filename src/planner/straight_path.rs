@@ -157,6 +157,7 @@ impl Planner {
             shapes: rec.into_shapes(),
             seconds: t.elapsed().as_secs_f64(),
             executable: true,
+            dips_on_case_samples: false,
         })
     }
 }

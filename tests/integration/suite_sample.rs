@@ -4,6 +4,16 @@
 
 use crate::suite::{Outcome, Rng, hanging_problem, planar_problem, run, spatial_problem};
 
+/// Problem `index` of `generate` from seed `seed`: the text of the case it draws after the
+/// problems before it.
+fn nth_problem(generate: fn(&mut Rng, usize) -> String, seed: u64, index: usize) -> String {
+    let mut rng = Rng(seed);
+    (0..=index)
+        .map(|j| generate(&mut rng, j))
+        .last()
+        .expect("a problem")
+}
+
 /// Problems `indices` (increasing) of `generate` (seed 1), planned; each must have static start
 /// and goal shapes.
 fn sample(generate: fn(&mut Rng, usize) -> String, kind: &str, indices: &[usize]) -> Vec<Outcome> {
@@ -22,9 +32,9 @@ fn sample(generate: fn(&mut Rng, usize) -> String, kind: &str, indices: &[usize]
 
 /// Every plan of the sample is collision-free, and an independent check on a grid twice as fine
 /// in k and four times as fine in s as the verification grid finds no penetration; no replay
-/// that departs by more than the 2 % tolerance, or snaps, is called coinciding. The sample: the planar problems `planar_0`, `planar_2` and `planar_3`
-/// (`planar_1`, whose start shape the first solve misses, has its own test below) and the
-/// first 3D problem, which must keep
+/// that departs by more than the 2 % tolerance, or snaps, is called coinciding. The sample:
+/// the planar problems `planar_0`, `planar_2` and `planar_3` (`planar_1`, whose start shape
+/// the first solve misses, has its own test below) and the first 3D problem, which must keep
 /// coinciding with their replays
 /// (measured 1.6 %, 1.5 %, 1.1 % and 0.7 % of L), and the second 3D problem with a static start
 /// and goal (`spatial_0`), whose straight-line path peaks at an end shape and coincides with its
@@ -99,14 +109,8 @@ fn suite_planar_plan_with(
     use dlo_planner::case;
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
-    let mut rng = Rng(seed);
-    let mut v: serde_json::Value = serde_json::from_str(
-        &(0..=i)
-            .map(|j| planar_problem(&mut rng, j))
-            .last()
-            .expect("a problem"),
-    )
-    .expect("generated JSON");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&nth_problem(planar_problem, seed, i)).expect("generated JSON");
     for (key, val) in fields.as_object().expect("an object") {
         v["plan"][key] = val.clone();
     }
@@ -563,11 +567,7 @@ fn clearance_on(
 /// The suite's planar problem `planar_<seed>_<index>`: its case text and its planner, with the
 /// defaults.
 fn planar_planner(seed: u64, index: usize) -> (String, dlo_planner::planner::Planner) {
-    let mut rng = Rng(seed);
-    let text = (0..=index)
-        .map(|j| planar_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
+    let text = nth_problem(planar_problem, seed, index);
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/planar.json"))
         .expect("a generated case");
     let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
@@ -779,11 +779,7 @@ fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
 fn equilibria_dipping_between_chords_are_replayed_on_twice_the_contact_samples() {
     use dlo_planner::planner::observer::Silent;
     use dlo_planner::planner::verify::fine_model;
-    let mut rng = Rng(1);
-    let text = (0..=58)
-        .map(|j| hanging_problem(&mut rng, j))
-        .last()
-        .expect("a problem");
+    let text = nth_problem(hanging_problem, 1, 58);
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/hanging.json"))
         .expect("a generated case");
     let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
@@ -1042,9 +1038,7 @@ fn a_start_the_first_solve_misses_is_found_with_a_stiffer_penalty() {
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::verify::{fine_model, shape_worst_clearance};
     use dlo_planner::statics::SolveStatus;
-    let mut rng = Rng(1);
-    let _first = planar_problem(&mut rng, 0);
-    let text = planar_problem(&mut rng, 1);
+    let text = nth_problem(planar_problem, 1, 1);
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_1.json")).unwrap();
     let p = Planner::from_case(&c).expect("the start pose has a static shape");
     assert_eq!(p.start.status, SolveStatus::Converged);
@@ -1064,11 +1058,7 @@ fn a_start_the_first_solve_misses_is_found_with_a_stiffer_penalty() {
 #[test]
 fn a_refused_pose_says_where_the_solve_searched() {
     use dlo_planner::planner::Planner;
-    let mut rng = Rng(1);
-    let text = (0..=33)
-        .map(|i| planar_problem(&mut rng, i))
-        .last()
-        .unwrap();
+    let text = nth_problem(planar_problem, 1, 33);
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_33.json")).unwrap();
     let err = Planner::from_case(&c).expect_err("refused").to_string();
     assert!(err.contains("plan.goal"), "{err}");
@@ -1117,8 +1107,9 @@ fn a_goal_at_a_resting_start_pose_is_planned_without_moving() {
 /// goal 0.01 L and 0.05 L along x from the start's pose: a small move no path can make while
 /// keeping the safety margin next to the start (the straight-line path comes within 5.1e-5 L
 /// and 2.7e-4 L of the obstacle between the resting shapes, held off it on the chords). The
-/// plan is the equilibria along the straight-line path's trajectory, the rod sliding over the obstacle: executable, peaking within the
-/// energy-gap tolerance (1 %) of the lower bound on U_max, the larger end energy, and the
+/// plan is the equilibria along the straight-line path's trajectory, the rod sliding over the
+/// obstacle: executable, peaking within the energy-gap tolerance (1 %) of the lower bound on
+/// U_max, the larger end energy, and the
 /// gripper's path within 1 % of the straight-line distance. (Before, the optimiser ran, did
 /// not converge, and the plan, its path's replayed equilibria, took the end 1.93 L and 2.09 L
 /// round, with 2.9 and 2.7 rad of turning, to peak at most 0.04 % lower.)
