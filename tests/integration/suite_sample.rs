@@ -402,6 +402,24 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The equilibria `e` of `p`'s plan are executable on the chords between contact points, held
+/// off the obstacles by a margin within a twentieth of the coincidence tolerance; the margin
+/// (case units).
+fn held_off_on_chords(
+    p: &dlo_planner::planner::Planner,
+    e: &dlo_planner::planner::equilibrium_plan::EquilibriumPlan,
+) -> f64 {
+    assert!(e.executable, "{:?}", e.reason);
+    assert_eq!(e.contact, "chords");
+    let l = p.base.model.rod.length;
+    let margin = e.contact_margin.expect("held off the obstacles");
+    assert!(
+        margin > 0.0 && margin <= 0.05 * p.settings.coincide_tolerance * l,
+        "margin {margin}"
+    );
+    margin
+}
+
 /// The suite's planar problem `planar_1_8` (seed 1), planned without the quick attempt
 /// (`"quick_attempt": false`; with it, the quick plan's replayed equilibria at the contact
 /// points are the plan): the replayed equilibria of the case's own plan dip into an obstacle
@@ -414,14 +432,9 @@ fn equilibria_that_dip_on_chords_too_are_held_off_by_twice_the_depth() {
     let (p, r) = suite_planar_plan_with(1, 8, serde_json::json!({ "quick_attempt": false }));
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
-    assert!(e.executable && e.reason.is_none(), "{e:?}");
-    assert_eq!(e.contact, "chords");
+    assert!(e.reason.is_none(), "{e:?}");
+    let margin = held_off_on_chords(&p, e);
     let l = p.base.model.rod.length;
-    let margin = e.contact_margin.expect("held off the obstacles");
-    assert!(
-        margin > 0.0 && margin <= 0.05 * p.settings.coincide_tolerance * l,
-        "margin {margin}"
-    );
     assert!(e.min_clearance.expect("obstacles") > 0.0, "{e:?}");
     // Complementarity at the margin: a step with a contact force holds the rod the margin off
     // the obstacle, and a step farther off has none (to 1e-6 L).
@@ -788,15 +801,9 @@ fn equilibria_dipping_between_chords_are_replayed_on_twice_the_contact_samples()
     let r = p.run(&mut Silent);
     assert!(!r.replay.coincide);
     let ep = r.equilibrium_plan.as_ref().expect("the equilibria judged");
-    assert!(ep.executable, "{:?}", ep.reason);
+    held_off_on_chords(&p, ep);
     assert_eq!(ep.contact_samples, Some(64));
-    assert_eq!(ep.contact, "chords");
     let l = p.base.model.rod.length;
-    let margin = ep.contact_margin.expect("held off");
-    assert!(
-        margin > 0.0 && margin <= 0.05 * p.settings.coincide_tolerance * l,
-        "{margin}"
-    );
     assert!(r.verdict().is_executable());
     let first = r.replay.steps.first().expect("steps");
     assert_eq!(
