@@ -77,10 +77,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         [0.0, 0.0, 1.1],
         [0.0; 3],
     ));
-    let held = StaticProblem::builder(strip.clone(), Layout::of(&strip, 4))
+    let builder = StaticProblem::builder(strip.clone(), Layout::of(&strip, 4))
         .clamp(0.0, [0.0; 3], &[0.0])
-        .obstacle(block, 0.0)
-        .build()?;
+        .obstacle(block, 0.0);
+    let held = builder.clone().build()?;
     let about_y = |t: f64| {
         [
             [t.cos(), 0.0, t.sin()],
@@ -90,7 +90,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let start = End::pose(&held, [0.5, 0.0, 0.6], about_y(FRAC_PI_2));
     let goal = End::pose(&held, [-0.5, 0.0, 0.6], about_y(-FRAC_PI_2));
-    let planner = Planner::new(PlanProblem::new(held, start, goal), PlanSettings::default())?;
+    // As `dlo plan` makes it: with more contact samples where an end shape dips between the
+    // problem's (`Planner::new` keeps them).
+    let problem = PlanProblem::new(held, start, goal);
+    let planner = Planner::with_contact_samples(&builder, problem, PlanSettings::default())?;
     let plan = planner.run(&mut Silent);
     println!(
         "plan: {} ({}), U_max {:.4} (straight path {:.4}), clearance {:.4} (straight path {:.4}), the optimal path's replay {} (largest deviation {:.2e} L)",

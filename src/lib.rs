@@ -15,7 +15,8 @@
 //! - [`optim`]: the generic multiplier method, BFGS and Newton steps;
 //! - [`statics`]: static shapes — [`statics::StaticProblem::builder`] builds a problem in code,
 //!   [`statics::solve_static`] solves it and reports reactions, moment balance and stability;
-//! - [`planner`]: deformation paths (§7) — [`planner::Planner::new`] takes a
+//! - [`planner`]: deformation paths (§7) — [`planner::Planner::new`] (or
+//!   [`planner::Planner::with_contact_samples`], as `dlo plan` makes it) takes a
 //!   [`planner::PlanProblem`] and [`planner::PlanSettings`], plans, verifies and replays;
 //! - [`grasp`]: the disturbance force margin of a grasp (§6);
 //! - [`case`]: case files, an adapter from JSON to the types above;

@@ -171,7 +171,8 @@ class End:
         quaternion: Optional[Sequence[float]] = None,
     ) -> End:
         """A pose: position and orientation as a rotation matrix (rows; columns ξ, η and the
-        tangent ζ) or a unit quaternion ``(w, x, y, z)``."""
+        tangent ζ) or a unit quaternion ``(w, x, y, z)``; with neither, the orientation is left
+        free."""
     @staticmethod
     def shape(coefficients: Sequence[float]) -> End:
         """A shape given by its coefficients (``StaticShape.a``)."""

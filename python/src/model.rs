@@ -569,7 +569,8 @@ pub struct End {
 #[pymethods]
 impl End {
     /// The pose of the `s = L` cross-section: `position` and its orientation, as a rotation
-    /// matrix (rows; columns ξ, η and the tangent ζ) or a unit quaternion `(w, x, y, z)`.
+    /// matrix (rows; columns ξ, η and the tangent ζ) or a unit quaternion `(w, x, y, z)`; with
+    /// neither, the orientation is left free (the static shape that holds the end there).
     #[staticmethod]
     #[pyo3(signature = (position, rotation=None, quaternion=None))]
     fn pose(
@@ -589,10 +590,17 @@ impl End {
                 r
             }
             (None, Some(q)) => rotation_of(q)?,
-            _ => {
+            (None, None) => {
+                return Ok(End {
+                    position: Some(position),
+                    rotation: None,
+                    shape: None,
+                });
+            }
+            (Some(_), Some(_)) => {
                 return Err(input_error(
                     Some("rotation"),
-                    "give a rotation matrix or a quaternion, not both or neither",
+                    "give a rotation matrix or a quaternion, not both",
                 ));
             }
         };
@@ -618,6 +626,7 @@ impl End {
 
     fn __repr__(&self) -> String {
         match (&self.position, &self.shape) {
+            (Some(p), None) if self.rotation.is_none() => format!("End.pose(position={p:?})"),
             (Some(p), _) => format!("End.pose(position={p:?}, rotation={:?})", self.rotation),
             (None, Some(a)) => format!("End.shape({} coefficients)", a.len()),
             _ => "End()".into(),
@@ -633,6 +642,7 @@ impl End {
     ) -> dlo_planner::planner::End {
         match (&self.position, &self.rotation, &self.shape) {
             (Some(p), Some(r), _) => dlo_planner::planner::End::pose(held, *p, *r),
+            (Some(p), None, _) => dlo_planner::planner::End::position(held, *p),
             (_, _, Some(a)) => dlo_planner::planner::End::shape(a.clone()),
             _ => unreachable!("an End is built by `pose` or `shape`"),
         }

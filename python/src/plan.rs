@@ -39,7 +39,7 @@ pub(crate) fn plan(
     let speeds = speed_limits(max_speed, max_angular_speed)?;
     let t0 = Instant::now();
     let planner = py
-        .detach(|| Planner::new(plan_problem, settings))
+        .detach(|| Planner::with_contact_samples(&problem.builder, plan_problem, settings))
         .map_err(setup_error)?;
     let obstacles = planner.obstacles.clone();
     let run = Run {

@@ -79,7 +79,8 @@ def test_plan_fields():
         dlo.plan(held, far, goal)
     assert field_of(lambda: dlo.End.pose([0, 0, 1], quaternion=[2, 0, 0, 0])) == "quaternion"
     assert field_of(lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 2]])) == "rotation"
-    assert field_of(lambda: dlo.End.pose([0, 0, 1])) == "rotation"
+    both = lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 1]], quaternion=[1, 0, 0, 0])  # noqa: E731
+    assert field_of(both) == "rotation"
 
 
 def test_case_fields(tmp_path):

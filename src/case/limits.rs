@@ -8,8 +8,7 @@ use crate::rod::Profile;
 
 /// Largest `panels × gauss_points` (quadrature nodes: each Hessian costs nodes × unknowns²).
 pub const MAX_NODES: usize = 8000;
-/// Largest `samples` with self-contact (its rows grow as samples²).
-pub const MAX_SELF_CONTACT_SAMPLES: usize = 400;
+pub use crate::rod::model::MAX_SELF_CONTACT_SAMPLES;
 /// Largest count of constraints, of forces, of report points.
 pub const MAX_ITEMS: usize = 1000;
 /// Largest count of obstacles.

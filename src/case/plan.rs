@@ -347,107 +347,13 @@ impl crate::planner::Planner {
     }
 }
 
-/// Times the contact samples may be doubled where an end shape dips between them.
-const CONTACT_DOUBLINGS: u32 = 2;
-
-/// The planner of `case`'s `problem` ([`plan_problem`]) with `settings`
-/// ([`Planner::new`](crate::planner::Planner::new)). Where an end shape dips into an obstacle
-/// between the contact points its solve holds clear, on a grid four times finer in s than the
-/// verification grid ([`crate::planner::Planner::end_dip`]: a rod wrapped round an obstacle
-/// whose radius is not much larger than the points' spacing), the case's problem is made
-/// again with twice the contact samples (`discretisation.samples`), and again with four times
-/// (with self-contact, whose rows grow as the samples squared, twice only), within their
-/// limits, its end solves started from the shapes solved before. The first whose end shapes
-/// rest clear on that grid is the planner, and says so
-/// ([`crate::planner::Planner::contact_refinement`]); where none does, the case's own (whose
-/// plan then reports the end inside the obstacle). Either way the planner lists the tries
-/// whose end shapes still dipped, or did not solve
-/// ([`crate::planner::Planner::contact_tries`]).
+/// The planner of `case`'s `problem` ([`plan_problem`]) with `settings`, made with more
+/// contact samples where an end shape dips between the case's
+/// ([`Planner::with_contact_samples`](crate::planner::Planner::with_contact_samples)).
 pub fn planner(
     case: &Case,
     problem: crate::planner::PlanProblem,
     settings: PlanSettings,
 ) -> Result<crate::planner::Planner, crate::planner::PlanSetupError> {
-    use crate::planner::{ContactRefinement, ContactTry, Planner};
-    let mut own = Planner::new(problem.clone(), settings.clone())?;
-    let Some(dipped) = own.end_dip() else {
-        own.finer_contacts = finer_contacts(case, &own, case.builder.sample_count());
-        return Ok(own);
-    };
-    let case_samples = case.builder.sample_count();
-    // Self-contact rows grow as the samples squared: one doubling only.
-    let most = most_samples(&own);
-    let doublings = if own.has_self_contact() {
-        1
-    } else {
-        CONTACT_DOUBLINGS
-    };
-    let mut seeded = problem;
-    seeded.start.shape = Some(own.start.a.clone());
-    seeded.goal.shape = Some(own.goal.a.clone());
-    let mut tries = Vec::new();
-    for n in (1..=doublings).map(|d| case_samples << d) {
-        if n > most {
-            break;
-        }
-        let Ok(statics) = case.builder.clone().samples(n).build() else {
-            break;
-        };
-        seeded.statics = statics;
-        let Ok(mut p) = Planner::new(seeded.clone(), settings.clone()) else {
-            tries.push(ContactTry {
-                samples: n,
-                dipped: None,
-            });
-            break;
-        };
-        match p.end_dip() {
-            None => {
-                p.finer_contacts = finer_contacts(case, &p, n);
-                p.contact_refinement = Some(ContactRefinement {
-                    case_samples,
-                    samples: n,
-                    dipped,
-                });
-                p.contact_tries = tries;
-                return Ok(p);
-            }
-            still => tries.push(ContactTry {
-                samples: n,
-                dipped: still,
-            }),
-        }
-        seeded.start.shape = Some(p.start.a.clone());
-        seeded.goal.shape = Some(p.goal.a.clone());
-    }
-    own.contact_tries = tries;
-    own.finer_contacts = finer_contacts(case, &own, case_samples);
-    Ok(own)
-}
-
-/// `case`'s static problem with twice `samples` contact samples, for `planner`'s replayed
-/// equilibria that dip between the chords of its own
-/// ([`crate::planner::Planner::finer_contacts`]); `None` where that is beyond the limits
-/// (with self-contact, whose rows grow as the samples squared, its own limit), or where the
-/// case has no obstacle.
-fn finer_contacts(
-    case: &Case,
-    planner: &crate::planner::Planner,
-    samples: usize,
-) -> Option<std::sync::Arc<(usize, crate::statics::StaticProblem)>> {
-    let n = 2 * samples;
-    (!planner.obstacles.is_empty() && n <= most_samples(planner))
-        .then(|| case.builder.clone().samples(n).build().ok())
-        .flatten()
-        .map(|p| std::sync::Arc::new((n, p)))
-}
-
-/// The most contact samples `planner`'s case may be made with: with self-contact, whose rows
-/// grow as the samples squared, fewer.
-fn most_samples(planner: &crate::planner::Planner) -> usize {
-    if planner.has_self_contact() {
-        super::limits::MAX_SELF_CONTACT_SAMPLES
-    } else {
-        crate::rod::model::MAX_SAMPLES
-    }
+    crate::planner::Planner::with_contact_samples(&case.builder, problem, settings)
 }

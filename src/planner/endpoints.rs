@@ -103,6 +103,18 @@ impl End {
         }
     }
 
+    /// The controlled end at `position` (case units), its orientation left free (as a case
+    /// file's end with a position and no angles), for a rod of `problem`.
+    pub fn position(problem: &StaticProblem, position: [f64; 3]) -> End {
+        let mut end = End::pose(
+            problem,
+            position,
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        );
+        end.rotation = None;
+        end
+    }
+
     /// The shape of coefficients `a` itself, not solved for.
     pub fn shape(a: Vec<f64>) -> End {
         End {

@@ -5,6 +5,7 @@
 //! and replays, telling a [`PlanObserver`] every shape it computes.
 
 mod clear_samples;
+pub mod contact_samples;
 pub mod endpoints;
 pub mod equilibrium_plan;
 pub mod minimax;
@@ -177,14 +178,14 @@ pub struct Planner {
     pub start_contacts: Option<f64>,
     /// Where the planner was made with more contact samples than its case's, because an end
     /// shape dipped into an obstacle between the case's (set by
-    /// [`crate::case::plan::planner`]; reported as [`PlanResult::contact_samples`]).
+    /// [`Planner::with_contact_samples`]; reported as [`PlanResult::contact_samples`]).
     pub contact_refinement: Option<ContactRefinement>,
     /// The planners made with more contact samples whose end shapes still dipped, or did not
-    /// solve (set by [`crate::case::plan::planner`]; reported as
+    /// solve (set by [`Planner::with_contact_samples`]; reported as
     /// [`PlanResult::contact_samples_tried`]).
     pub contact_tries: Vec<ContactTry>,
     /// The count of contact samples (intervals) and `base` with them, twice `base`'s (set by
-    /// [`crate::case::plan::planner`]; `None` where the limits leave no room): where no plan
+    /// [`Planner::with_contact_samples`]; `None` where the limits leave no room): where no plan
     /// of the search is executable and replayed equilibria still dip into an obstacle between
     /// the chords of `base`'s sample points, they are replayed again on the chords of these,
     /// whose dips are about a quarter as deep.

@@ -32,6 +32,9 @@ pub struct Discretisation {
 
 /// Most intervals between the points checked against obstacles and self-contact.
 pub const MAX_SAMPLES: usize = 2000;
+/// Most `samples` with self-contact (its rows grow as samples²): a case file's bound, and the
+/// bound on the samples a plan is made again with.
+pub const MAX_SELF_CONTACT_SAMPLES: usize = 400;
 
 /// Checks the sizes a problem is built with against the ranges a case file allows: basis
 /// pairs 0..=32, panels 1..=2000, Gauss points 1..=16, sample intervals 1..=2000; the error
