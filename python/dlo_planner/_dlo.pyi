@@ -169,10 +169,12 @@ class End:
         position: Vec3,
         rotation: Optional[Matrix3] = None,
         quaternion: Optional[Sequence[float]] = None,
+        angles: Optional[Sequence[float]] = None,
     ) -> End:
         """A pose: position and orientation as a rotation matrix (rows; columns ξ, η and the
-        tangent ζ) or a unit quaternion ``(w, x, y, z)``; with neither, the orientation is left
-        free."""
+        tangent ζ), a unit quaternion ``(w, x, y, z)`` or Euler angles as a case file writes
+        them (``[theta]`` planar, kept as written; ``[phi, theta, psi]`` 3D, in the branch
+        nearest the written ``phi``); with none, the orientation is left free."""
     @staticmethod
     def shape(coefficients: Sequence[float]) -> End:
         """A shape given by its coefficients (``StaticShape.a``)."""

@@ -563,22 +563,43 @@ pub(crate) fn static_settings(given: Option<&Bound<'_, PyAny>>) -> PyResult<Stat
 pub struct End {
     pub(crate) position: Option<[f64; 3]>,
     pub(crate) rotation: Option<[[f64; 3]; 3]>,
+    /// Euler angles as a case file writes them (`[θ]` planar, `[φ, θ, ψ]` 3D).
+    pub(crate) angles: Option<Vec<f64>>,
     pub(crate) shape: Option<Vec<f64>>,
 }
 
 #[pymethods]
 impl End {
     /// The pose of the `s = L` cross-section: `position` and its orientation, as a rotation
-    /// matrix (rows; columns ξ, η and the tangent ζ) or a unit quaternion `(w, x, y, z)`; with
-    /// neither, the orientation is left free (the static shape that holds the end there).
+    /// matrix (rows; columns ξ, η and the tangent ζ), a unit quaternion `(w, x, y, z)` or Euler
+    /// angles as a case file writes them (`[θ]` on a planar rod, `[φ, θ, ψ]` on a 3D one);
+    /// with none, the orientation is left free (the static shape that holds the end there).
     #[staticmethod]
-    #[pyo3(signature = (position, rotation=None, quaternion=None))]
+    #[pyo3(signature = (position, rotation=None, quaternion=None, angles=None))]
     fn pose(
         position: [f64; 3],
         rotation: Option<[[f64; 3]; 3]>,
         quaternion: Option<[f64; 4]>,
+        angles: Option<Vec<f64>>,
     ) -> PyResult<Self> {
         let position = vec3("position", position)?;
+        if let Some(angles) = angles {
+            if rotation.is_some() || quaternion.is_some() {
+                return Err(input_error(
+                    Some("angles"),
+                    "give one orientation: a rotation matrix, a quaternion or Euler angles",
+                ));
+            }
+            for (i, x) in angles.iter().enumerate() {
+                finite(&format!("angles[{i}]"), *x)?;
+            }
+            return Ok(End {
+                position: Some(position),
+                rotation: None,
+                angles: Some(angles),
+                shape: None,
+            });
+        }
         let rotation = match (rotation, quaternion) {
             (Some(r), None) => {
                 for (i, row) in r.iter().enumerate() {
@@ -594,6 +615,7 @@ impl End {
                 return Ok(End {
                     position: Some(position),
                     rotation: None,
+                    angles: None,
                     shape: None,
                 });
             }
@@ -607,6 +629,7 @@ impl End {
         Ok(End {
             position: Some(position),
             rotation: Some(rotation),
+            angles: None,
             shape: None,
         })
     }
@@ -620,12 +643,16 @@ impl End {
         Ok(End {
             position: None,
             rotation: None,
+            angles: None,
             shape: Some(coefficients),
         })
     }
 
     fn __repr__(&self) -> String {
         match (&self.position, &self.shape) {
+            (Some(p), None) if self.angles.is_some() => {
+                format!("End.pose(position={p:?}, angles={:?})", self.angles)
+            }
             (Some(p), None) if self.rotation.is_none() => format!("End.pose(position={p:?})"),
             (Some(p), _) => format!("End.pose(position={p:?}, rotation={:?})", self.rotation),
             (None, Some(a)) => format!("End.shape({} coefficients)", a.len()),
@@ -635,17 +662,23 @@ impl End {
 }
 
 impl End {
-    /// The library's end on `held`.
+    /// The library's end on `held`; an error names `angles` where their count is not the
+    /// rod's.
     pub(crate) fn resolve(
         &self,
         held: &dlo_planner::statics::StaticProblem,
-    ) -> dlo_planner::planner::End {
-        match (&self.position, &self.rotation, &self.shape) {
-            (Some(p), Some(r), _) => dlo_planner::planner::End::pose(held, *p, *r),
-            (Some(p), None, _) => dlo_planner::planner::End::position(held, *p),
-            (_, _, Some(a)) => dlo_planner::planner::End::shape(a.clone()),
+    ) -> PyResult<dlo_planner::planner::End> {
+        use dlo_planner::planner::End as Lib;
+        Ok(match (&self.position, &self.rotation, &self.shape) {
+            (Some(p), _, _) if self.angles.is_some() => {
+                let angles = self.angles.as_deref().unwrap_or_default();
+                Lib::euler(held, *p, angles).map_err(|m| input_error(Some("angles"), m))?
+            }
+            (Some(p), Some(r), _) => Lib::pose(held, *p, *r),
+            (Some(p), None, _) => Lib::position(held, *p),
+            (_, _, Some(a)) => Lib::shape(a.clone()),
             _ => unreachable!("an End is built by `pose` or `shape`"),
-        }
+        })
     }
 }
 

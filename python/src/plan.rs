@@ -33,7 +33,7 @@ pub(crate) fn plan(
     let settings: PlanSettings = crate::settings::merged(settings, "plan")?;
     let static_settings = static_settings(solver)?;
     let held = problem.build()?;
-    let (start, goal) = (start.resolve(&held), goal.resolve(&held));
+    let (start, goal) = (start.resolve(&held)?, goal.resolve(&held)?);
     let mut plan_problem = PlanProblem::new(held, start, goal);
     plan_problem.static_settings = static_settings;
     let speeds = speed_limits(max_speed, max_angular_speed)?;

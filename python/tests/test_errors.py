@@ -1,6 +1,7 @@
 """Bad input raises `InputError` naming the field; nothing is half-written."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -81,6 +82,10 @@ def test_plan_fields():
     assert field_of(lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 2]])) == "rotation"
     both = lambda: dlo.End.pose([0, 0, 1], rotation=[[1, 0, 0], [0, 1, 0], [0, 0, 1]], quaternion=[1, 0, 0, 0])  # noqa: E731
     assert field_of(both) == "rotation"
+    assert field_of(lambda: dlo.End.pose([0, 0, 1], quaternion=[1, 0, 0, 0], angles=[0.0])) == "angles"
+    assert field_of(lambda: dlo.End.pose([0, 0, 1], angles=[math.nan])) == "angles[0]"
+    three = dlo.End.pose([0.5, 0, 0.7], angles=[0.0, 0.1, 0.0])
+    assert field_of(lambda: dlo.plan(held, three, goal)) == "angles"
 
 
 def test_case_fields(tmp_path):

@@ -176,19 +176,35 @@ def test_ctrl_c_stops_a_plan_and_finishes_its_log(log_dir):
 def test_a_plan_built_in_code_gets_more_contact_samples_where_an_end_dips():
     # The suite's `planar_23_32` built in code: a weighted strip whose start shape rests on a
     # box and, with 32 contact samples, dips into it between them. As for its case file, the
-    # plan is made with 64, and says so.
-    rod = dlo.Rod(length=1.0, flexural_rigidity=1.0, radius=0.005, weight_per_length=2.077137946600859)
-    box = dlo.Obstacle.cuboid(
-        "o0", [0.12962989521859997, 0.5, 0.23949155252862306], position=[0.21047778296036052, 0, 0.7740211749613708]
-    )
-    ball = dlo.Obstacle.ball("o1", 0.13506722366681664, position=[-0.09581712520354546, 0, 1.0546705630449538])
+    # plan is made with 64, says so, and is the case file's plan.
+    weight, theta = 2.077137946600859, -0.44047250979395397
+    half, centre = [0.12962989521859997, 0.5, 0.23949155252862306], [0.21047778296036052, 0, 0.7740211749613708]
+    radius, ball_centre = 0.13506722366681664, [-0.09581712520354546, 0, 1.0546705630449538]
+    start_xz, goal_xz = [0.36786029295501793, 0.47891368327740175], [-0.3153362750107965, 0.5353857431833525]
+    rod = dlo.Rod(length=1.0, flexural_rigidity=1.0, radius=0.005, weight_per_length=weight)
+    box = dlo.Obstacle.cuboid("o0", half, position=centre)
+    ball = dlo.Obstacle.ball("o1", radius, position=ball_centre)
     held = dlo.StaticProblem(rod).orientation(0.0, theta=0.0).obstacle(box).obstacle(ball)
-    theta = -0.44047250979395397
-    turn = [[math.cos(theta), 0, math.sin(theta)], [0, 1, 0], [-math.sin(theta), 0, math.cos(theta)]]
-    start = dlo.End.pose([0.36786029295501793, 0.0, 0.47891368327740175])
-    goal = dlo.End.pose([-0.3153362750107965, 0.0, 0.5353857431833525], rotation=turn)
+    start = dlo.End.pose([start_xz[0], 0.0, start_xz[1]])
+    goal = dlo.End.pose([goal_xz[0], 0.0, goal_xz[1]], angles=[theta])
     plan = dlo.plan(held, start, goal)
     refined = plan.to_dict()["contact_samples"]
     assert (refined["case_samples"], refined["samples"]) == (32, 64)
     assert refined["dipped"]["end"] == "start" and refined["dipped"]["clearance"] < -1e-4
     assert plan.end_inside_obstacle is None and plan.executable, plan.verdict
+    case = {
+        "name": "plan",
+        "planar": True,
+        "rod": {"length": 1.0, "flexural_rigidity": 1.0, "radius": 0.005, "weight_per_length": weight},
+        "constraints": [{"type": "orientation", "s": 0.0, "theta": 0.0}],
+        "obstacles": [
+            {"name": "o0", "shape": {"type": "cuboid", "half_extents": half}, "position": centre},
+            {"name": "o1", "shape": {"type": "ball", "radius": radius}, "position": ball_centre},
+        ],
+        "plan": {
+            "start": {"x": start_xz[0], "z": start_xz[1]},
+            "goal": {"x": goal_xz[0], "z": goal_xz[1], "theta": theta},
+        },
+    }
+    from_file = dlo.Case.parse(json.dumps(case)).plan()
+    assert strip_files_and_timing(plan.to_dict()) == strip_files_and_timing(from_file.to_dict())

@@ -103,6 +103,42 @@ impl End {
         }
     }
 
+    /// The controlled end at `position` (case units) with Euler angles `angles` (radians), as
+    /// a case file writes them: `[θ]` on a planar rod, kept as written (θ + 2π is another
+    /// shape, a loop); `[φ, θ, ψ]` (ZYZ, case axes) on a 3D rod, whose branch is chosen when
+    /// the plan is set up, nearest the written φ (equivalent spellings give the same plan).
+    /// Errors name the problem (a count of angles that is not the rod's).
+    pub fn euler(
+        problem: &StaticProblem,
+        position: [f64; 3],
+        angles: &[f64],
+    ) -> Result<End, String> {
+        use crate::rod::layout::Field;
+        let mut end = End::position(problem, position);
+        match (problem.model.layout.spatial, angles) {
+            (false, &[theta]) => end.angles = vec![(Field::Theta, theta)],
+            (true, &[phi, theta, psi]) => {
+                end.rotation = Some(EndRotation {
+                    matrix: crate::rod::kinematics::rotation(phi, theta, psi),
+                    written_phi: Some(phi),
+                });
+            }
+            (spatial, _) => {
+                return Err(format!(
+                    "{} Euler angles given; a {} rod's end takes {}",
+                    angles.len(),
+                    if spatial { "3D" } else { "planar" },
+                    if spatial {
+                        "3: [phi, theta, psi]"
+                    } else {
+                        "1: [theta]"
+                    }
+                ));
+            }
+        }
+        Ok(end)
+    }
+
     /// The controlled end at `position` (case units), its orientation left free (as a case
     /// file's end with a position and no angles), for a rod of `problem`.
     pub fn position(problem: &StaticProblem, position: [f64; 3]) -> End {
