@@ -284,6 +284,70 @@ pub fn seed_towards(
     a
 }
 
+/// Starting shapes for a second search of an end pose whose solve from its first start did
+/// not converge (the rod caught on an obstacle it was pulled through on its way): `a0` (the
+/// problem's initial shape) where that was not the first start (`first_bent`), then rods bent
+/// by [`seed_towards`] from the held frame `held` to end tangents chosen from the end's
+/// position `position` (units of L, all the layout's components): the circular arc from the
+/// held tangent through the chord to the position, the chord's own direction, and on a planar
+/// rod the arc's end tangent turned a quarter turn either way (a rod that goes round an
+/// obstacle on the other side); before them, where the end's angles are prescribed (`angles`)
+/// and the first start was not already bent to them, a rod bent to those.
+pub fn retry_seeds(
+    model: &Model,
+    a0: &[f64],
+    first_bent: bool,
+    held: ([f64; 3], bool),
+    position: Option<[f64; 3]>,
+    angles: Option<[f64; 3]>,
+) -> Vec<Vec<f64>> {
+    let mut seeds = Vec::new();
+    if first_bent {
+        seeds.push(a0.to_vec());
+    }
+    let (h, phi_fixed) = held;
+    let bent = |end: [f64; 3]| seed_towards(model, a0, h, phi_fixed, end);
+    if let Some(end) = angles.filter(|_| !first_bent) {
+        seeds.push(bent(end));
+    }
+    let Some(x) = position else {
+        return seeds;
+    };
+    let d = model.to_angles(std::array::from_fn(|i| x[i] - model.base[i]));
+    let n = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if n.is_nan() || n <= 1e-9 {
+        return seeds;
+    }
+    let d = d.map(|v| v / n);
+    let frame = crate::rod::kinematics::rotation(h[0], h[1], h[2]);
+    let t0 = [frame[0][2], frame[1][2], frame[2][2]];
+    let dot = (0..3).map(|i| d[i] * t0[i]).sum::<f64>();
+    let arc: [f64; 3] = std::array::from_fn(|i| 2.0 * dot * d[i] - t0[i]);
+    // Euler angles of an end tangent `t`, without twist about it (φ + ψ held).
+    let angles_of = |t: [f64; 3]| -> [f64; 3] {
+        if model.layout.spatial {
+            let theta = t[2].clamp(-1.0, 1.0).acos();
+            let phi = if t[0].hypot(t[1]) > 1e-12 {
+                t[1].atan2(t[0])
+            } else {
+                h[0]
+            };
+            [phi, theta, h[0] + h[2] - phi]
+        } else {
+            [0.0, t[0].atan2(t[2]), 0.0]
+        }
+    };
+    let mut ends = vec![angles_of(arc), angles_of(d)];
+    if !model.layout.spatial {
+        let theta = ends[0][1];
+        let quarter = std::f64::consts::FRAC_PI_2;
+        ends.push([0.0, theta + quarter, 0.0]);
+        ends.push([0.0, theta - quarter, 0.0]);
+    }
+    seeds.extend(ends.into_iter().map(bent));
+    seeds
+}
+
 /// Solves the static shape for `pose` from `a_start`.
 pub fn solve_end(
     base: &StaticProblem,
@@ -293,4 +357,73 @@ pub fn solve_end(
 ) -> StaticSolution {
     let mut p = pose.problem(base);
     solve_static(&mut p, a_start, opts)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::rod::Rod;
+    use crate::rod::layout::Layout;
+    use crate::rod::model::{Discretisation, Model};
+
+    fn model(rod: Rod) -> Model {
+        let layout = Layout::of(&rod, 4);
+        let d = Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        };
+        Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0])
+    }
+
+    /// A planar rod held along +z with its end at (0.5, 0, 0.5) L: the chord runs at 45°, so the
+    /// circular arc through it ends at 90°; the seeds' end angles are the arc's, the chord's,
+    /// and the arc's a quarter turn either way, after the prescribed angle where one is given.
+    #[test]
+    fn planar_seeds_end_along_the_arc_the_chord_and_a_quarter_turn_either_way() {
+        let m = model(Rod::uniform(1.0, 1.0));
+        let a0 = vec![0.0; m.n()];
+        let pi = std::f64::consts::PI;
+        let seeds = super::retry_seeds(
+            &m,
+            &a0,
+            false,
+            ([0.0; 3], false),
+            Some([0.5, 0.0, 0.5]),
+            Some([0.0, 0.3, 0.0]),
+        );
+        let ends: Vec<f64> = seeds.iter().map(|a| m.angles_at(a, 1.0)[1]).collect();
+        let want = [0.3, pi / 2.0, pi / 4.0, pi, 0.0];
+        assert_eq!(ends.len(), want.len());
+        for (got, want) in ends.iter().zip(want) {
+            assert!((got - want).abs() <= 1e-12, "{ends:?}");
+        }
+        for a in &seeds {
+            assert!(m.angles_at(a, 0.0)[1].abs() <= 1e-12, "held at θ(0) = 0");
+        }
+    }
+
+    /// A 3D rod held along +z with its end at (0, 0.5, 0.5) L: the arc bends in the y–z plane
+    /// (φ = 90°) to θ = 90°, the chord's direction is θ = 45°, and φ + ψ stays the held end's
+    /// (no twist). The natural start comes first where the first search started bent.
+    #[test]
+    fn spatial_seeds_bend_in_the_plane_of_the_chord() {
+        let m = model(Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0));
+        let a0 = vec![0.0; m.n()];
+        let pi = std::f64::consts::PI;
+        let seeds = super::retry_seeds(
+            &m,
+            &a0,
+            true,
+            ([0.0; 3], false),
+            Some([0.0, 0.5, 0.5]),
+            None,
+        );
+        assert_eq!(seeds.len(), 3);
+        assert_eq!(seeds[0], a0);
+        for (a, theta) in seeds[1..].iter().zip([pi / 2.0, pi / 4.0]) {
+            let [phi, t, psi] = m.angles_at(a, 1.0);
+            assert!((phi - pi / 2.0).abs() <= 1e-12, "{phi}");
+            assert!((t - theta).abs() <= 1e-12, "{t}");
+            assert!((phi + psi).abs() <= 1e-12, "{psi}");
+        }
+    }
 }

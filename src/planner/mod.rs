@@ -345,7 +345,41 @@ fn end_shape(
             (None, None) => problem.initial.clone(),
         };
         let sol = solve_from(pose.problem(base), &a0, opts);
-        on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
+        let first = on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance);
+        if first.0.status == SolveStatus::Converged || end.shape.is_some() {
+            first
+        } else {
+            // Searched again from rods bent other ways: the lowest-energy shape that converges
+            // (stable ones first), else the first search's.
+            let position = full_position(&base.model, end);
+            let angles = if base.model.layout.spatial {
+                end_angles(end)
+            } else {
+                use crate::rod::layout::Field;
+                let theta = end.angles.iter().find(|(f, _)| *f == Field::Theta);
+                theta.map(|&(_, t)| [0.0, t, 0.0])
+            };
+            endpoints::retry_seeds(
+                &base.model,
+                &problem.initial,
+                seed.is_some(),
+                held,
+                position,
+                angles,
+            )
+            .into_iter()
+            .map(|a| {
+                let sol = solve_from(pose.problem(base), &a, opts);
+                on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
+            })
+            .filter(|(sol, _)| sol.status == SolveStatus::Converged)
+            .min_by(|(a, _), (b, _)| {
+                let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
+                let (ka, kb) = (key(a), key(b));
+                ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+            })
+            .unwrap_or(first)
+        }
     };
     if sol.status != SolveStatus::Converged {
         let msg = if !end.is_pose() {
@@ -364,13 +398,15 @@ fn end_shape(
                 });
             let from = if end.shape.is_some() {
                 "the end's `shape`"
+            } else if full_position(&base.model, end).is_some() {
+                "the natural state and from rods bent from the held end towards the pose (along the arc and the chord to its position, with the end's angles where they are given; on a planar rod also a quarter turn either way of the arc)"
             } else if seed.is_some() {
-                "a shape bent from the held end's frame towards the pose's"
+                "a shape bent from the held end's frame towards the pose's and from the natural state"
             } else {
                 "the natural state"
             };
             format!(
-                "the static solve found no shape that reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L){blocking}; it searches from {from}, at three starting penalties: a shape that goes round the obstacles another way may still exist, and a `shape` near it given to this end would start the solve there",
+                "the static solve found no shape that reaches this pose under the case's constraints and obstacles (solver: {:?}, violation {:.3e} in units of L){blocking}; it searches from {from}, at three starting penalties each: a shape that goes round the obstacles another way may still exist, and a `shape` near it given to this end would start the solve there",
                 sol.status, sol.max_violation
             )
         };
@@ -528,6 +564,17 @@ fn end_inside_obstacle(base: &StaticProblem, end: &End) -> Option<String> {
             )
         })
     })
+}
+
+/// An end's position (units of L, case axes), when its pose gives every component the layout
+/// has.
+fn full_position(model: &crate::rod::model::Model, end: &End) -> Option<[f64; 3]> {
+    let components = model.layout.components();
+    let mut x = [0.0; 3];
+    for &k in components {
+        x[k] = end.position.iter().find(|(j, _)| *j == k)?.1;
+    }
+    Some(x)
 }
 
 /// All three Euler angles of an end, when its pose gives them.
