@@ -650,8 +650,8 @@ impl End {
 
     fn __repr__(&self) -> String {
         match (&self.position, &self.shape) {
-            (Some(p), None) if self.angles.is_some() => {
-                format!("End.pose(position={p:?}, angles={:?})", self.angles)
+            (Some(p), None) if let Some(angles) = &self.angles => {
+                format!("End.pose(position={p:?}, angles={angles:?})")
             }
             (Some(p), None) if self.rotation.is_none() => format!("End.pose(position={p:?})"),
             (Some(p), _) => format!("End.pose(position={p:?}, rotation={:?})", self.rotation),

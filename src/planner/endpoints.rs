@@ -311,12 +311,18 @@ pub fn retry_seeds(
         seeds.push(bent(end));
     }
     let Some(x) = position else {
-        return seeds;
+        return seeds
+            .into_iter()
+            .filter(|a| first_bent || a != a0)
+            .collect();
     };
     let d = model.to_angles(std::array::from_fn(|i| x[i] - model.base[i]));
     let n = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     if n.is_nan() || n <= 1e-9 {
-        return seeds;
+        return seeds
+            .into_iter()
+            .filter(|a| first_bent || a != a0)
+            .collect();
     }
     let d = d.map(|v| v / n);
     let frame = crate::rod::kinematics::rotation(h[0], h[1], h[2]);
@@ -345,7 +351,19 @@ pub fn retry_seeds(
         ends.push([0.0, theta - quarter, 0.0]);
     }
     seeds.extend(ends.into_iter().map(bent));
-    seeds
+    distinct(seeds, a0, first_bent)
+}
+
+/// `seeds` each once, without `a0` where that was the first search's start (`!first_bent`): a
+/// split basis, which [`seed_towards`] does not bend, gives `a0` back.
+fn distinct(seeds: Vec<Vec<f64>>, a0: &[f64], first_bent: bool) -> Vec<Vec<f64>> {
+    let mut unique: Vec<Vec<f64>> = Vec::new();
+    for a in seeds {
+        if !unique.contains(&a) && (first_bent || a != a0) {
+            unique.push(a);
+        }
+    }
+    unique
 }
 
 /// Solves the static shape for `pose` from `a_start`.
@@ -399,6 +417,24 @@ mod tests {
         for a in &seeds {
             assert!(m.angles_at(a, 0.0)[1].abs() <= 1e-12, "held at θ(0) = 0");
         }
+    }
+
+    /// A split basis, which [`super::seed_towards`] does not bend, has no other start to give
+    /// than the first search's.
+    #[test]
+    fn a_split_basis_gives_no_second_start() {
+        let rod = Rod::uniform(1.0, 1.0);
+        let mut layout = Layout::of(&rod, 4);
+        layout.basis = crate::rod::basis::Basis::split_at(4, 0.5);
+        let d = Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        };
+        let m = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let a0 = vec![0.0; m.n()];
+        let held = ([0.0; 3], false);
+        let seeds = super::retry_seeds(&m, &a0, false, held, Some([0.5, 0.0, 0.5]), None);
+        assert!(seeds.is_empty());
     }
 
     /// A 3D rod held along +z with its end at (0, 0.5, 0.5) L: the arc bends in the y–z plane

@@ -402,6 +402,8 @@ fn end_shape(
                 "the natural state and from rods bent from the held end towards the pose (along the arc and the chord to its position, with the end's angles where they are given; on a planar rod also a quarter turn either way of the arc)"
             } else if seed.is_some() {
                 "a shape bent from the held end's frame towards the pose's and from the natural state"
+            } else if !base.model.layout.spatial && !end.angles.is_empty() {
+                "the natural state and from a rod bent from the held end to the end's angle"
             } else {
                 "the natural state"
             };
