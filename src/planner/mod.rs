@@ -288,8 +288,10 @@ fn end_shape(
     held: ([f64; 3], bool),
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
-    coincide_tolerance: f64,
+    settings: &PlanSettings,
 ) -> Result<(StaticSolution, Option<f64>), PlanSetupError> {
+    let (coincide_tolerance, least_energy) =
+        (settings.coincide_tolerance, settings.least_energy_ends);
     let seed = end_angles(end)
         .filter(|_| problem.statics.model.layout.spatial)
         .map(|e| (held, e));
@@ -346,11 +348,13 @@ fn end_shape(
         };
         let sol = solve_from(pose.problem(base), &a0, opts);
         let first = on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance);
-        if first.0.status == SolveStatus::Converged || end.shape.is_some() {
+        let converged = first.0.status == SolveStatus::Converged;
+        if end.shape.is_some() || (converged && !least_energy) {
             first
         } else {
             // Searched again from rods bent other ways: the lowest-energy shape that converges
-            // (stable ones first), else the first search's.
+            // (stable ones first; the first search's among them when it converged), else the
+            // first search's.
             let position = full_position(&base.model, end);
             let angles = if base.model.layout.spatial {
                 end_angles(end)
@@ -359,7 +363,7 @@ fn end_shape(
                 let theta = end.angles.iter().find(|(f, _)| *f == Field::Theta);
                 theta.map(|&(_, t)| [0.0, t, 0.0])
             };
-            endpoints::retry_seeds(
+            let retried = endpoints::retry_seeds(
                 &base.model,
                 &problem.initial,
                 seed.is_some(),
@@ -371,14 +375,31 @@ fn end_shape(
             .map(|a| {
                 let sol = solve_from(pose.problem(base), &a, opts);
                 on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
-            })
-            .filter(|(sol, _)| sol.status == SolveStatus::Converged)
-            .min_by(|(a, _), (b, _)| {
-                let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
-                let (ka, kb) = (key(a), key(b));
-                ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-            })
-            .unwrap_or(first)
+            });
+            let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
+            let best = retried
+                .filter(|(sol, _)| sol.status == SolveStatus::Converged)
+                .min_by(|(a, _), (b, _)| {
+                    let (ka, kb) = (key(a), key(b));
+                    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+                });
+            match best {
+                // The first search's shape stays unless another is stable where it is not, or
+                // has less energy by more than the solves' last digits (the same equilibrium
+                // reached from another start).
+                Some(b) if converged => {
+                    let (kb, kf) = (key(&b.0), key(&first.0));
+                    let lower = kb.1 < kf.1 - 1e-9 * kf.1.abs().max(1.0);
+                    let stabler = !kb.0 && kf.0;
+                    if stabler || (kb.0 == kf.0 && lower) {
+                        b
+                    } else {
+                        first
+                    }
+                }
+                Some(b) => b,
+                None => first,
+            }
         }
     };
     if sol.status != SolveStatus::Converged {
@@ -954,7 +975,7 @@ impl Planner {
             held,
             &fine,
             &static_options,
-            settings.coincide_tolerance,
+            &settings,
         )?;
         resolve(&mut goal_end, "goal", model.angles_at(&start.a, 1.0))?;
         let (goal, _) = end_shape(
@@ -964,7 +985,7 @@ impl Planner {
             held,
             &fine,
             &static_options,
-            settings.coincide_tolerance,
+            &settings,
         )?;
         if let Some(w) = &settings.workspace {
             check_workspace(model, w, [("start", &start), ("goal", &goal)])?;

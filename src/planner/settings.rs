@@ -108,6 +108,11 @@ pub struct PlanSettings {
     /// `false`: only the case's own attempt and those after it (no effect on a 3D rod, whose
     /// own stages carry the curvature).
     pub quick_attempt: bool,
+    /// Solve each end pose (without a `shape`) also from the rods bent towards it that a pose
+    /// the first solve misses is searched from ([`super::endpoints::retry_seeds`]), and take
+    /// the stable shape with the least energy of all that converge; `false` (default): the
+    /// first solve's shape, where it converges.
+    pub least_energy_ends: bool,
     /// Lift a converged plan that is collision-free but not executable — the quick attempt's
     /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the
     /// first fallback count's path terms and run equilibrium tracking on it again
@@ -185,6 +190,7 @@ impl Default for PlanSettings {
             workspace: None,
             straight_path_first: true,
             quick_attempt: true,
+            least_energy_ends: false,
             lift: true,
             time_limit: None,
         }
