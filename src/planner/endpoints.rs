@@ -385,6 +385,10 @@ mod tests {
 
     fn model(rod: Rod) -> Model {
         let layout = Layout::of(&rod, 4);
+        model_with(rod, layout)
+    }
+
+    fn model_with(rod: Rod, layout: Layout) -> Model {
         let d = Discretisation {
             panels: 8,
             gauss_points: 4,
@@ -426,11 +430,7 @@ mod tests {
         let rod = Rod::uniform(1.0, 1.0);
         let mut layout = Layout::of(&rod, 4);
         layout.basis = crate::rod::basis::Basis::split_at(4, 0.5);
-        let d = Discretisation {
-            panels: 8,
-            gauss_points: 4,
-        };
-        let m = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let m = model_with(rod, layout);
         let a0 = vec![0.0; m.n()];
         let held = ([0.0; 3], false);
         let seeds = super::retry_seeds(&m, &a0, false, held, Some([0.5, 0.0, 0.5]), None);
