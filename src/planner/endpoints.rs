@@ -311,18 +311,12 @@ pub fn retry_seeds(
         seeds.push(bent(end));
     }
     let Some(x) = position else {
-        return seeds
-            .into_iter()
-            .filter(|a| first_bent || a != a0)
-            .collect();
+        return distinct(seeds, a0, first_bent);
     };
     let d = model.to_angles(std::array::from_fn(|i| x[i] - model.base[i]));
     let n = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     if n.is_nan() || n <= 1e-9 {
-        return seeds
-            .into_iter()
-            .filter(|a| first_bent || a != a0)
-            .collect();
+        return distinct(seeds, a0, first_bent);
     }
     let d = d.map(|v| v / n);
     let frame = crate::rod::kinematics::rotation(h[0], h[1], h[2]);

@@ -122,6 +122,15 @@ impl PlanObserver for StopOnly<'_> {
     }
 }
 
+/// The chords the replayed equilibria's contacts were held on, for a reader: `"chords"` (the
+/// case's contact samples) or `"the chords of N contact samples"`
+/// ([`EquilibriumPlan::contact_samples`]).
+pub fn chords_named(samples: Option<usize>) -> String {
+    samples.map_or("chords".to_string(), |n| {
+        format!("the chords of {n} contact samples")
+    })
+}
+
 /// Values of `k` for a reader: `[0.015625, 0.01875, 0.025]` (nine decimals, trailing zeros
 /// dropped: the replay's steps and bisections are short binary fractions, which `{:?}` can
 /// print as `0.018750000000000003`).

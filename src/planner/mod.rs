@@ -841,8 +841,10 @@ impl Planner {
                         break;
                     };
                     let held = equilibrium_plan::held_off(finer, start_margin);
-                    let what =
-                        format!("replayed with contacts on the chords of {n} contact samples");
+                    let what = format!(
+                        "replayed with contacts on {}",
+                        equilibrium_plan::chords_named(Some(*n))
+                    );
                     let Some(start) = replay::start_under(&held, &self.start, &self.static_options)
                     else {
                         ep.retry_failed(&what, "the start pose's solve did not converge");
@@ -852,10 +854,7 @@ impl Planner {
                     pl.start = start;
                     (std::borrow::Cow::Owned(pl), finer, Some(held), Some(*n))
                 };
-                // (The case's samples' as the reports have always put them.)
-                let on = samples.map_or("chords".to_string(), |n| {
-                    format!("the chords of {n} contact samples")
-                });
+                let on = equilibrium_plan::chords_named(samples);
                 if let Some(chords) = chords {
                     let what = format!("replayed with contacts on {on}");
                     let (m, s) = (start_margin, samples);

@@ -640,9 +640,8 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             e.u_max,
             e.k_at_u_max,
             {
-                let chords = e.contact_samples.map_or("chords".to_string(), |n| {
-                    format!("the chords of {n} contact samples")
-                });
+                let chords =
+                    dlo_planner::planner::equilibrium_plan::chords_named(e.contact_samples);
                 match (e.contact_margin, e.contact) {
                     (Some(m), _) => {
                         format!("; contacts on {chords}, held {m:.2e} off the obstacles")
