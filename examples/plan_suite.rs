@@ -8,6 +8,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!     cargo run --release --example plan_suite -- --seed 1 --family hanging   # another family
+//!     cargo run --release --example plan_suite -- --seed 1 --units 0.6,0.02   # L = 0.6, Rf = 0.02
 //!
 //! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
 //! three obstacles (boxes, balls, capsules along y) beyond its swing, start and goal end poses
@@ -344,6 +345,52 @@ fn replay_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     worst
 }
 
+/// A generated problem (written with `L = 1` and `Rf = 1`) in units where the rod is `length`
+/// long and its flexural rigidity is `rigidity`: every length times `length` (the rod's length
+/// and radius, the held end's conditions, the obstacles' places and sizes, the end positions),
+/// the rigidities times `rigidity`, the weight per length times `rigidity / length³`. Angles and
+/// directions are kept, so the problem is the same one: its energies scale by `rigidity /
+/// length` and its lengths by `length`.
+pub fn in_units(text: &str, length: f64, rigidity: f64) -> String {
+    use serde_json::Value;
+    let mut v: Value = serde_json::from_str(text).expect("generated JSON");
+    let times = |x: &mut Value, f: f64| match x {
+        Value::Number(n) => *x = (n.as_f64().expect("a number") * f).into(),
+        Value::Array(a) => a
+            .iter_mut()
+            .for_each(|y| *y = (y.as_f64().expect("a number") * f).into()),
+        _ => panic!("a number or an array of numbers: {x}"),
+    };
+    let scale = |o: &mut Value, keys: &[&str], f: f64| {
+        for key in keys {
+            if let Some(x) = o.get_mut(*key) {
+                times(x, f);
+            }
+        }
+    };
+    let rod = &mut v["rod"];
+    scale(rod, &["length", "radius"], length);
+    scale(rod, &["flexural_rigidity", "torsional_rigidity"], rigidity);
+    scale(rod, &["weight_per_length"], rigidity / length.powi(3));
+    let lengths = ["s", "x", "y", "z", "position"];
+    for c in v["constraints"].as_array_mut().into_iter().flatten() {
+        scale(c, &lengths, length);
+    }
+    for o in v["obstacles"].as_array_mut().into_iter().flatten() {
+        scale(o, &["position"], length);
+        let shape = o["shape"].as_object_mut().expect("a shape");
+        for (key, value) in shape.iter_mut() {
+            if !matches!(key.as_str(), "type" | "obj") {
+                times(value, length);
+            }
+        }
+    }
+    for end in ["start", "goal"] {
+        scale(&mut v["plan"][end], &lengths, length);
+    }
+    serde_json::to_string_pretty(&v).expect("JSON")
+}
+
 /// The case of a generated problem, with `plan` settings and `top` case fields given.
 fn problem_case(
     text: &str,
@@ -522,6 +569,23 @@ fn main() {
             })
     };
     let (plan, top) = (json_arg("--plan"), json_arg("--case"));
+    // `--units 0.6,0.02`: every problem with the rod's length and flexural rigidity in other
+    // units ([`in_units`]); `1,1` by default, the problems as generated.
+    let units = args
+        .iter()
+        .position(|a| a == "--units")
+        .and_then(|i| args.get(i + 1))
+        .map(|u| {
+            let v: Vec<f64> = u
+                .split(',')
+                .map(|x| x.parse().expect("--units LENGTH,RIGIDITY: numbers"))
+                .collect();
+            assert!(
+                v.len() == 2 && v.iter().all(|x| x.is_finite() && *x > 0.0),
+                "--units LENGTH,RIGIDITY: two positive numbers"
+            );
+            (v[0], v[1])
+        });
     // `--only planar` or `--only 3d`: the other kind's problems are generated (the stream of
     // problems stays the same) but not planned.
     let only = args
@@ -543,6 +607,10 @@ fn main() {
                 planar_problem(&mut rng, i)
             } else {
                 spatial_problem(&mut rng, i)
+            };
+            let text = match units {
+                Some((l, r)) => in_units(&text, l, r),
+                None => text,
             };
             i += 1;
             if let Some(dir) = &write_dir {
@@ -603,11 +671,14 @@ fn main() {
         }
     }
     println!(
-        "Suite seed {seed}: {} {planar_kind} and {} 3D problems (generated again where start or goal has no static shape: {} {planar_kind}, {} 3D), planner settings {}{}.\n",
+        "Suite seed {seed}: {} {planar_kind} and {} 3D problems (generated again where start or goal has no static shape: {} {planar_kind}, {} 3D){}, planner settings {}{}.\n",
         n_planar,
         n_spatial,
         regenerated[0],
         regenerated[1],
+        units.map_or(String::new(), |(l, r)| format!(
+            " in units where L = {l} and Rf = {r}"
+        )),
         if plan.as_object().is_none_or(|o| o.is_empty()) {
             "all at their defaults".to_string()
         } else {

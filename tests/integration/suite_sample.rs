@@ -2,7 +2,7 @@
 //! every setting at its default: problems of the planar and of the 3D generator, each started
 //! from seed 1, named by their place in its sequence.
 
-use crate::suite::{Outcome, Rng, hanging_problem, planar_problem, run, spatial_problem};
+use crate::suite::{Outcome, Rng, hanging_problem, in_units, planar_problem, run, spatial_problem};
 
 /// Problem `index` of `generate` from seed `seed`: the text of the case it draws after the
 /// problems before it.
@@ -1297,4 +1297,39 @@ fn least_energy_ends_take_the_lowest_stable_shape_of_the_starts() {
     let worst = shape_worst_clearance(&fine, &c.obstacles, &least.goal.a).expect("obstacles");
     assert!(worst.clearance >= -1e-6 * l, "{worst:?}");
     assert_eq!(least.start.a, first.start.a);
+}
+
+/// `plan_suite --units`: a generated problem in units where the rod is 0.6 long with flexural
+/// rigidity 0.02 (a cable in metres and N m²) is the same problem, so the plan is the same:
+/// the same verdict and attempts, U_max scaled by `Rf / L` and the gripper's travel ratio
+/// equal, to 1e-6 relative (the planner works in units of L; the scaled inputs differ from
+/// the scaled-back ones in their last digits). Planar problems 0 (optimised, quick attempt)
+/// and 2 (with weight, the straight path) of seed 1, and the 3D generator's first.
+#[test]
+fn a_problem_in_other_units_plans_the_same() {
+    let none = serde_json::json!({});
+    let (l, rf) = (0.6, 0.02);
+    for (text, name) in [
+        (nth_problem(planar_problem, 1, 0), "planar_0"),
+        (nth_problem(planar_problem, 1, 2), "planar_2"),
+        (nth_problem(spatial_problem, 1, 0), "spatial_0"),
+    ] {
+        let base = run(&text, name, &none, &none).expect("static ends");
+        let scaled = run(&in_units(&text, l, rf), name, &none, &none).expect("static ends");
+        assert!(base.executable, "{name}: {:?}", base.why_not);
+        assert_eq!(scaled.executable, base.executable, "{name}");
+        assert_eq!(scaled.attempts, base.attempts, "{name}");
+        let u = scaled.u_max / (rf / l);
+        assert!(
+            (u - base.u_max).abs() <= 1e-6 * base.u_max,
+            "{name}: U_max {u} against {}",
+            base.u_max
+        );
+        assert!(
+            (scaled.travel - base.travel).abs() <= 1e-6 * base.travel,
+            "{name}: travel {} against {}",
+            scaled.travel,
+            base.travel
+        );
+    }
 }
