@@ -7,6 +7,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1 --only 3d   # plan the 3D problems only
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
+//!     cargo run --release --example plan_suite -- --seed 1 --case '{"rod": {"radius": 0.03}}'
 //!     cargo run --release --example plan_suite -- --seed 1 --family hanging   # another family
 //!     cargo run --release --example plan_suite -- --seed 1 --units 0.6,0.02   # L = 0.6, Rf = 0.02
 //!
@@ -28,7 +29,8 @@
 //! independent clearance check of every plan called collision-free on a grid twice as fine in
 //! k as the verification's and four times as fine in s, and of every plan executable
 //! by its replayed equilibria at each replayed shape on a grid four times finer in s (the
-//! worst of these is the "worst false collision-free" of the table: it must be ≥ −1e-6 L).
+//! worst of these is the "worst false collision-free" of the table: it must be ≥ −1e-6 L, and
+//! the runner exits with 1 after the table, naming the plans, where one is not).
 
 use dlo_planner::case;
 use dlo_planner::planner::observer::Silent;
@@ -295,7 +297,7 @@ pub struct Outcome {
 /// shape at `4 verify_s + 1` points in s (both grids twice or four times the verification
 /// grid's; units of L), and where in k.
 fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
-    let model = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
+    let model = fine_model(&p.base.model, 4 * p.verify_s_intervals(), 2);
     let path = p.with_terms(r.path_terms).path();
     let n = 2 * (p.settings.verify_k_samples - 1);
     let mut a = vec![0.0; path.n()];
@@ -391,6 +393,22 @@ pub fn in_units(text: &str, length: f64, rigidity: f64) -> String {
     serde_json::to_string_pretty(&v).expect("JSON")
 }
 
+/// `fields` written over `v`: an object's fields one by one, so that `{"rod": {"radius": 0.03}}`
+/// changes the rod's radius and keeps its other fields; anything else replaced.
+pub fn merge(v: &mut serde_json::Value, fields: &serde_json::Value) {
+    match (v.as_object_mut(), fields.as_object()) {
+        (Some(o), Some(f)) => {
+            for (key, value) in f {
+                merge(
+                    o.entry(key.clone()).or_insert(serde_json::Value::Null),
+                    value,
+                );
+            }
+        }
+        _ => *v = fields.clone(),
+    }
+}
+
 /// The case of a generated problem, with `plan` settings and `top` case fields given.
 fn problem_case(
     text: &str,
@@ -398,19 +416,27 @@ fn problem_case(
     plan: &serde_json::Value,
     top: &serde_json::Value,
 ) -> Option<case::Case> {
+    case_of(text, name, plan, top).ok()
+}
+
+/// [`problem_case`], or why the case file it makes is not a case.
+fn case_of(
+    text: &str,
+    name: &str,
+    plan: &serde_json::Value,
+    top: &serde_json::Value,
+) -> Result<case::Case, String> {
     let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
     for (key, value) in plan.as_object().into_iter().flatten() {
         v["plan"][key] = value.clone();
     }
-    for (key, value) in top.as_object().into_iter().flatten() {
-        v[key] = value.clone();
-    }
+    merge(&mut v, top);
     // The case's folder in this crate, wherever the runner is started from: the 3D problems'
     // mesh (`meshes/cube.obj`) is read relative to it.
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("planning_cases")
         .join(format!("{name}.json"));
-    case::parse(&v.to_string(), &path).ok()
+    case::parse(&v.to_string(), &path).map_err(|e| e.to_string())
 }
 
 /// Whether a generated problem counts (its start and goal have static shapes), without
@@ -558,8 +584,9 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .map(std::path::PathBuf::from);
     // `--plan '{"path_terms": 4}'`: planner settings given to every problem (to measure other
-    // settings on the same problems); `--case '{"angle_frame": "case"}'`: top-level case
-    // fields given to every problem; none by default.
+    // settings on the same problems); `--case '{"angle_frame": "case"}'`: case fields given to
+    // every problem, objects field by field (`--case '{"rod": {"radius": 0.03}}'`); none by
+    // default.
     let json_arg = |flag: &str| -> serde_json::Value {
         args.iter()
             .position(|a| a == flag)
@@ -593,6 +620,28 @@ fn main() {
         .position(|a| a == "--only")
         .and_then(|i| args.get(i + 1))
         .map(|k| if k == "planar" { 0 } else { 1 });
+    let generate = |kind: usize, rng: &mut Rng, i: usize| {
+        let text = if kind == 0 && hanging {
+            hanging_problem(rng, i)
+        } else if kind == 0 {
+            planar_problem(rng, i)
+        } else {
+            spatial_problem(rng, i)
+        };
+        match units {
+            Some((l, r)) => in_units(&text, l, r),
+            None => text,
+        }
+    };
+    // Settings or case fields that no generated problem takes would have every problem
+    // generated again, for ever: the first of each kind must be a case.
+    for (kind, count) in [(0, n_planar), (1, n_spatial)] {
+        let text = generate(kind, &mut Rng(seed), 0);
+        if let (true, Err(e)) = (count > 0, case_of(&text, "first", &plan, &top)) {
+            eprintln!("plan_suite: --plan and --case make no case of the generated problems: {e}");
+            std::process::exit(2);
+        }
+    }
     let mut rng = Rng(seed);
     let mut skipped = [0usize; 2];
     let mut results: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
@@ -601,17 +650,7 @@ fn main() {
         let mut i = 0;
         while results[kind].len() < count {
             let name = format!("{}_{seed}_{i}", [planar_kind, "spatial"][kind]);
-            let text = if kind == 0 && hanging {
-                hanging_problem(&mut rng, i)
-            } else if kind == 0 {
-                planar_problem(&mut rng, i)
-            } else {
-                spatial_problem(&mut rng, i)
-            };
-            let text = match units {
-                Some((l, r)) => in_units(&text, l, r),
-                None => text,
-            };
+            let text = generate(kind, &mut rng, i);
             i += 1;
             if let Some(dir) = &write_dir {
                 std::fs::create_dir_all(dir).expect("--write: a directory");
@@ -697,5 +736,23 @@ fn main() {
     print!("{}", table(planar_kind, &results[0]));
     if n_spatial > 0 {
         print!("{}", table("3D", &results[1]));
+    }
+    // A plan called collision-free (or executable by its replayed equilibria) that the finer
+    // check finds inside an obstacle fails the run.
+    let false_clear: Vec<String> = results
+        .iter()
+        .flatten()
+        .filter_map(|o| {
+            o.checked_clearance
+                .filter(|(d, _)| *d < -1e-6)
+                .map(|(d, k)| format!("{} ({d:+.2e} L at k = {k:.4})", o.name))
+        })
+        .collect();
+    if !false_clear.is_empty() {
+        eprintln!(
+            "plan_suite: plans called collision-free lie inside an obstacle on the finer check: {}",
+            false_clear.join(", ")
+        );
+        std::process::exit(1);
     }
 }

@@ -60,7 +60,8 @@ const COLLISION_TOLERANCE: f64 = 1e-6;
 const END_GRID_REFINEMENT: usize = 4;
 
 /// The grid in s on which an end shape resting on an obstacle must be clear
-/// ([`END_GRID_REFINEMENT`] times the verification grid's `verify_s_samples` intervals).
+/// ([`END_GRID_REFINEMENT`] times the verification grid's intervals in s,
+/// [`Planner::verify_s_intervals`]).
 fn end_grid(model: &crate::rod::model::Model, verify_s_samples: usize) -> crate::rod::model::Model {
     fine_model(model, END_GRID_REFINEMENT * verify_s_samples, 2)
 }
@@ -208,8 +209,8 @@ pub struct Planner {
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
-    /// The grid the end shapes were checked on ([`end_grid`]), with the `verify_s_samples` it
-    /// was made for.
+    /// The grid the end shapes were checked on ([`end_grid`]), with the verification grid's
+    /// intervals in s it was made for ([`Planner::verify_s_intervals`]).
     end_grid: Arc<(usize, crate::rod::model::Model)>,
 }
 
@@ -966,7 +967,8 @@ impl Planner {
         let (mut start_end, mut goal_end) = (problem.start.clone(), problem.goal.clone());
         resolve(&mut start_end, "start", held.0)?;
         // The grid on which an end shape resting on an obstacle must be clear.
-        let fine = end_grid(model, settings.verify_s_samples);
+        let verify_s = settings.verify_s_for(model.rod.radius, model.rod.length);
+        let fine = end_grid(model, verify_s);
         let (start, start_contacts) = end_shape(
             &problem,
             "start",
@@ -1015,7 +1017,7 @@ impl Planner {
             quick: false,
             finer_retry: false,
             workers: workers::Workers::new(settings.threads()),
-            end_grid: Arc::new((settings.verify_s_samples, fine)),
+            end_grid: Arc::new((verify_s, fine)),
             settings,
         })
     }
@@ -1088,7 +1090,7 @@ impl Planner {
     /// The grid the end shapes are checked on: the one the planner was made with, or where
     /// `verify_s_samples` has changed since, one made for it ([`end_grid`]).
     fn end_check_grid(&self) -> Arc<(usize, crate::rod::model::Model)> {
-        let n = self.settings.verify_s_samples;
+        let n = self.verify_s_intervals();
         if self.end_grid.0 == n {
             self.end_grid.clone()
         } else {
@@ -1105,6 +1107,12 @@ impl Planner {
             .filter(|e| e.clearance < -tol)
             .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
             .cloned()
+    }
+
+    /// The verification grid's intervals in s for this rod ([`PlanSettings::verify_s_for`]).
+    pub fn verify_s_intervals(&self) -> usize {
+        let rod = &self.base.model.rod;
+        self.settings.verify_s_for(rod.radius, rod.length)
     }
 
     /// Depth below which a verified clearance counts as a collision (1e-6 L).
@@ -1364,7 +1372,7 @@ impl Planner {
         let t0 = std::time::Instant::now();
         let path = self.path();
         let nv = path.n_vars();
-        let fine = fine_model(model, self.settings.verify_s_samples, 4);
+        let fine = fine_model(model, self.verify_s_intervals(), 4);
         // Reported only: where its shapes lie inside an obstacle, at grid values.
         let straight = self.verify_on(&fine, &path, &vec![0.0; nv], true);
         {

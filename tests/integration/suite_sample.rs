@@ -2,7 +2,9 @@
 //! every setting at its default: problems of the planar and of the 3D generator, each started
 //! from seed 1, named by their place in its sequence.
 
-use crate::suite::{Outcome, Rng, hanging_problem, in_units, planar_problem, run, spatial_problem};
+use crate::suite::{
+    Outcome, Rng, hanging_problem, in_units, merge, planar_problem, run, spatial_problem,
+};
 
 /// Problem `index` of `generate` from seed `seed`: the text of the case it draws after the
 /// problems before it.
@@ -645,7 +647,7 @@ fn an_end_resting_on_an_obstacle_is_solved_on_chords_and_plans() {
     let (p, points) = resting_start(3, 35, false);
     let l = p.base.model.rod.length;
     // Four times finer in s than the verification grid.
-    let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
+    let fine = fine_model(&p.base.model, 4 * p.verify_s_intervals(), 2);
     let (at_points, on_chords) = (
         clearance_on(&p, &fine, &points.a),
         clearance_on(&p, &fine, &p.start.a),
@@ -672,7 +674,7 @@ fn an_end_bulging_into_an_obstacle_is_held_off_it_and_plans() {
     let (p, chords) = resting_start(6, 55, true);
     let model = &p.base.model;
     let l = model.rod.length;
-    let fine = fine_model(model, 4 * p.settings.verify_s_samples, 2);
+    let fine = fine_model(model, 4 * p.verify_s_intervals(), 2);
     let (on_chords, held_off) = (
         clearance_on(&p, &fine, &chords.a),
         clearance_on(&p, &fine, &p.start.a),
@@ -716,7 +718,7 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
     let refined = p.contact_refinement.as_ref().expect("more contact samples");
     assert_eq!((refined.case_samples, refined.samples), (32, 64));
     assert_eq!(refined.dipped.end, "start");
-    let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
+    let fine = fine_model(&p.base.model, 4 * p.verify_s_intervals(), 2);
     // The case's own planner, with its 32 samples.
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/planar.json"))
         .expect("a generated case");
@@ -728,7 +730,7 @@ fn an_end_that_dips_between_contact_points_is_solved_with_more_of_them() {
         (refined.dipped.clearance - depth).abs() <= 1e-3 * l,
         "{refined:?} vs {depth}"
     );
-    let grid = fine_model(&p.base.model, 16 * p.settings.verify_s_samples, 2);
+    let grid = fine_model(&p.base.model, 16 * p.verify_s_intervals(), 2);
     for a in [&p.start.a, &p.goal.a] {
         let c = clearance_on(&p, &grid, a);
         assert!(c >= -1e-6 * l, "{c}");
@@ -770,7 +772,7 @@ fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
     assert_eq!(refined.samples, 128);
     assert!(p.start_contacts.is_some());
     let l = p.base.model.rod.length;
-    let finer = fine_model(&p.base.model, 16 * p.settings.verify_s_samples, 2);
+    let finer = fine_model(&p.base.model, 16 * p.verify_s_intervals(), 2);
     let at_points = clearance_on(&p, &finer, &points.a);
     assert!(at_points < -2e-5 * l, "{at_points}");
     for a in [&p.start.a, &p.goal.a] {
@@ -875,7 +877,7 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     use dlo_planner::planner::{PlanStatus, PlanVerdict, observer::Silent};
     let (text, p) = planar_planner(5, 30);
     let l = p.base.model.rod.length;
-    let fine = fine_model(&p.base.model, 4 * p.settings.verify_s_samples, 2);
+    let fine = fine_model(&p.base.model, 4 * p.verify_s_intervals(), 2);
     let depth = clearance_on(&p, &fine, &p.goal.a);
     assert!(depth < -1e-4 * l, "{depth}");
     assert!(p.contact_refinement.is_none());
@@ -1049,7 +1051,7 @@ fn a_start_the_first_solve_misses_is_found_with_a_stiffer_penalty() {
     assert_eq!(p.start.status, SolveStatus::Converged);
     assert_eq!(p.start.stable, Some(true));
     assert!(p.start.max_violation <= 1e-9);
-    let fine = fine_model(&p.base.model, p.settings.verify_s_samples, 4);
+    let fine = fine_model(&p.base.model, p.verify_s_intervals(), 4);
     let worst = shape_worst_clearance(&fine, &c.obstacles, &p.start.a).expect("obstacles");
     assert!(
         worst.clearance >= -1e-6 * c.problem.model.rod.length,
@@ -1091,7 +1093,7 @@ fn a_goal_the_search_from_the_natural_state_misses_is_found_from_a_bent_rod() {
             tip[k]
         );
     }
-    let fine = fine_model(&p.base.model, p.settings.verify_s_samples, 4);
+    let fine = fine_model(&p.base.model, p.verify_s_intervals(), 4);
     let worst = shape_worst_clearance(&fine, &c.obstacles, &p.goal.a).expect("obstacles");
     assert!(worst.clearance >= -1e-6 * l, "{worst:?}");
 }
@@ -1293,7 +1295,7 @@ fn least_energy_ends_take_the_lowest_stable_shape_of_the_starts() {
         (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9 * l),
         "{x:?} vs {y:?}"
     );
-    let fine = fine_model(model, first.settings.verify_s_samples, 4);
+    let fine = fine_model(model, first.verify_s_intervals(), 4);
     let worst = shape_worst_clearance(&fine, &c.obstacles, &least.goal.a).expect("obstacles");
     assert!(worst.clearance >= -1e-6 * l, "{worst:?}");
     assert_eq!(least.start.a, first.start.a);
@@ -1332,4 +1334,24 @@ fn a_problem_in_other_units_plans_the_same() {
             base.travel
         );
     }
+}
+
+/// `plan_suite --case` writes objects field by field: `{"rod": {"radius": 0.03}}` changes the
+/// generated rod's radius and keeps its length and rigidity; other values are replaced.
+#[test]
+fn suite_case_fields_merge_into_objects() {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&nth_problem(planar_problem, 1, 0)).expect("generated JSON");
+    let rod = v["rod"].clone();
+    merge(
+        &mut v,
+        &serde_json::json!({"rod": {"radius": 0.03}, "angle_frame": "case", "planar": true}),
+    );
+    assert_eq!(v["rod"]["radius"], 0.03);
+    for key in ["length", "flexural_rigidity"] {
+        assert_eq!(v["rod"][key], rod[key], "{key}");
+    }
+    assert_eq!(v["angle_frame"], "case");
+    assert_eq!(v["planar"], true);
+    assert_eq!(v["obstacles"].as_array().map(Vec::len), Some(3));
 }
