@@ -44,7 +44,7 @@ use verify::fine_model;
 
 pub use result::{
     Attempt, ContactRefinement, ContactTry, EndInside, PlanReport, PlanResult, PlanStatus,
-    PlanVerdict, StartSummary, Timing,
+    PlanVerdict, StartSummary, Timing, VerificationGrid,
 };
 use start::Verified;
 use starts::StartPlan;

@@ -382,6 +382,8 @@ pub struct PlanReport<'a> {
     /// The result.
     #[serde(flatten)]
     pub result: &'a PlanResult,
+    /// The verification grid the plan was checked on.
+    pub verification_grid: VerificationGrid,
     /// Internal energy of the start shape (case units).
     pub start_energy: f64,
     /// Internal energy of the goal shape (case units).
@@ -397,6 +399,16 @@ pub struct PlanReport<'a> {
     pub trajectory_csv: Option<String>,
 }
 
+/// The verification grid of a plan ([`PlanReport::verification_grid`]).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct VerificationGrid {
+    /// Uniform samples of `k` (`verify_k_samples`).
+    pub k_samples: usize,
+    /// Uniform intervals of `s`: `verify_s_samples`, finer for a rod thinner than 0.005 L
+    /// ([`super::Planner::verify_s_intervals`]).
+    pub s_intervals: usize,
+}
+
 impl<'a> PlanReport<'a> {
     /// The report of `result`, planned by `planner`, without files.
     pub fn new(case: &'a str, planner: &super::Planner, result: &'a PlanResult) -> Self {
@@ -405,6 +417,10 @@ impl<'a> PlanReport<'a> {
             verdict: result.verdict(),
             executed_path: result.executed_path(),
             result,
+            verification_grid: VerificationGrid {
+                k_samples: planner.settings.verify_k_samples,
+                s_intervals: planner.verify_s_intervals(),
+            },
             start_energy: planner.start.energy.internal(),
             goal_energy: planner.goal.energy.internal(),
             mcap: None,

@@ -1355,3 +1355,32 @@ fn suite_case_fields_merge_into_objects() {
     assert_eq!(v["planar"], true);
     assert_eq!(v["obstacles"].as_array().map(Vec::len), Some(3));
 }
+
+/// The report gives the verification grid: `verify_s_samples` (256) intervals for the suite's
+/// strip 0.005 L thick, and 573 (256 √5, rounded up) for the same problem with the default
+/// radius L/1000 ([`dlo_planner::planner::PlanSettings::verify_s_for`]).
+#[test]
+fn the_report_gives_a_thin_rods_finer_verification_grid() {
+    use dlo_planner::planner::{PlanReport, Planner, observer::Silent};
+    let text = nth_problem(planar_problem, 1, 2);
+    for (radius, s_intervals) in [(Some(0.005), 256), (None, 573)] {
+        let mut v: serde_json::Value = serde_json::from_str(&text).expect("generated JSON");
+        match radius {
+            Some(r) => assert_eq!(v["rod"]["radius"], r),
+            None => {
+                v["rod"].as_object_mut().unwrap().remove("radius");
+            }
+        }
+        let c = dlo_planner::case::parse(&v.to_string(), std::path::Path::new("thin.json"))
+            .expect("a case");
+        let p = Planner::from_case(&c).expect("start and goal solve");
+        let r = p.run(&mut Silent);
+        let report = serde_json::to_value(PlanReport::new("thin", &p, &r)).unwrap();
+        assert_eq!(report["verification_grid"]["k_samples"], 201);
+        assert_eq!(
+            report["verification_grid"]["s_intervals"], s_intervals,
+            "{radius:?}"
+        );
+        assert!(r.verdict().is_executable(), "{radius:?}: {}", r.verdict());
+    }
+}
