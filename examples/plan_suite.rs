@@ -419,6 +419,16 @@ fn problem_case(
     case_of(text, name, plan, top).ok()
 }
 
+/// A generated problem's case file with `plan` settings and `top` case fields given.
+fn with_fields(text: &str, plan: &serde_json::Value, top: &serde_json::Value) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
+    for (key, value) in plan.as_object().into_iter().flatten() {
+        v["plan"][key] = value.clone();
+    }
+    merge(&mut v, top);
+    v
+}
+
 /// [`problem_case`], or why the case file it makes is not a case.
 fn case_of(
     text: &str,
@@ -426,11 +436,7 @@ fn case_of(
     plan: &serde_json::Value,
     top: &serde_json::Value,
 ) -> Result<case::Case, String> {
-    let mut v: serde_json::Value = serde_json::from_str(text).expect("generated JSON");
-    for (key, value) in plan.as_object().into_iter().flatten() {
-        v["plan"][key] = value.clone();
-    }
-    merge(&mut v, top);
+    let v = with_fields(text, plan, top);
     // The case's folder in this crate, wherever the runner is started from: the 3D problems'
     // mesh (`meshes/cube.obj`) is read relative to it.
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -577,7 +583,8 @@ fn main() {
     let n_spatial = arg("--spatial", if hanging { 0 } else { 30 }) as usize;
     let planar_kind = if hanging { "hanging" } else { "planar" };
     let verbose = args.iter().any(|a| a == "--verbose");
-    // `--write DIR`: every generated case file is written there, for `dlo plan DIR/NAME.json`.
+    // `--write DIR`: every generated case file is written there, for `dlo plan DIR/NAME.json`
+    // (with the `--units`, `--plan` and `--case` it is planned with).
     let write_dir = args
         .iter()
         .position(|a| a == "--write")
@@ -660,8 +667,16 @@ fn main() {
                 let meshes = Path::new(env!("CARGO_MANIFEST_DIR")).join("planning_cases/meshes/");
                 let quoted = format!("{:?}", meshes.display().to_string());
                 let open = &quoted[..quoted.len() - 1];
-                let text = text.replace(r#""obj": "meshes/"#, &format!(r#""obj": {open}"#));
-                std::fs::write(dir.join(format!("{name}.json")), &text).expect("--write: writable");
+                // With `--plan` or `--case`, the case file as planned.
+                let given = |f: &serde_json::Value| f.as_object().is_some_and(|o| !o.is_empty());
+                let written = if given(&plan) || given(&top) {
+                    serde_json::to_string_pretty(&with_fields(&text, &plan, &top)).expect("JSON")
+                } else {
+                    text.clone()
+                };
+                let written = written.replace(r#""obj": "meshes/"#, &format!(r#""obj": {open}"#));
+                std::fs::write(dir.join(format!("{name}.json")), &written)
+                    .expect("--write: writable");
             }
             if only.is_some_and(|o| o != kind) {
                 if counts(&text, &name, &plan, &top) {
