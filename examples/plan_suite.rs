@@ -603,6 +603,8 @@ fn main() {
             })
     };
     let (plan, top) = (json_arg("--plan"), json_arg("--case"));
+    let given = |f: &serde_json::Value| f.as_object().is_some_and(|o| !o.is_empty());
+    let (plan_given, top_given) = (given(&plan), given(&top));
     // `--units 0.6,0.02`: every problem with the rod's length and flexural rigidity in other
     // units ([`in_units`]); `1,1` by default, the problems as generated.
     let units = args
@@ -668,8 +670,7 @@ fn main() {
                 let quoted = format!("{:?}", meshes.display().to_string());
                 let open = &quoted[..quoted.len() - 1];
                 // With `--plan` or `--case`, the case file as planned.
-                let given = |f: &serde_json::Value| f.as_object().is_some_and(|o| !o.is_empty());
-                let written = if given(&plan) || given(&top) {
+                let written = if plan_given || top_given {
                     serde_json::to_string_pretty(&with_fields(&text, &plan, &top)).expect("JSON")
                 } else {
                     text.clone()
@@ -733,15 +734,15 @@ fn main() {
         units.map_or(String::new(), |(l, r)| format!(
             " in units where L = {l} and Rf = {r}"
         )),
-        if plan.as_object().is_none_or(|o| o.is_empty()) {
-            "all at their defaults".to_string()
-        } else {
+        if plan_given {
             plan.to_string()
-        },
-        if top.as_object().is_none_or(|o| o.is_empty()) {
-            String::new()
         } else {
+            "all at their defaults".to_string()
+        },
+        if top_given {
             format!(", case fields {top}")
+        } else {
+            String::new()
         }
     );
     println!(

@@ -225,6 +225,13 @@ fn bad(field: impl Into<String>, message: impl Into<String>) -> SettingsError {
     SettingsError::new(field, message)
 }
 
+/// The largest `verify_s_samples`, and the most intervals in s a thin rod's verification grid
+/// takes ([`PlanSettings::verify_s_for`]).
+const MAX_VERIFY_S: usize = 10_000;
+
+/// The most points (`verify_k_samples` × intervals in s) of one verification pass.
+const MAX_VERIFY_GRID: usize = 10_000_000;
+
 /// The rod radius (a fraction of its length) down to which `verify_s_samples` is the
 /// verification grid's intervals in s ([`PlanSettings::verify_s_for`]).
 pub const THIN_ROD: f64 = 0.005;
@@ -246,8 +253,8 @@ impl PlanSettings {
         }
         let factor = (thin / radius.max(thin * 1e-12)).sqrt();
         let n = (self.verify_s_samples as f64 * factor).ceil();
-        let cap = 10_000
-            .min(10_000_000 / self.verify_k_samples.max(1))
+        let cap = MAX_VERIFY_S
+            .min(MAX_VERIFY_GRID / self.verify_k_samples.max(1))
             .max(self.verify_s_samples);
         (n as usize).min(cap)
     }
@@ -261,7 +268,7 @@ impl PlanSettings {
             ("path_terms", self.path_terms, terms_lo, terms_hi),
             ("k_samples", self.k_samples, 3, 2001),
             ("verify_k_samples", self.verify_k_samples, 3, 100_001),
-            ("verify_s_samples", self.verify_s_samples, 2, 10_000),
+            ("verify_s_samples", self.verify_s_samples, 2, MAX_VERIFY_S),
             ("starts", self.starts, 1, 64),
             ("replay_steps", self.replay_steps, 1, 100_000),
             ("replay_refinements", self.replay_refinements, 0, 20),
@@ -302,7 +309,7 @@ impl PlanSettings {
         }
         // Grid points of one verification pass.
         let grid = self.verify_k_samples.saturating_mul(self.verify_s_samples);
-        if grid > 10_000_000 {
+        if grid > MAX_VERIFY_GRID {
             return Err(bad(
                 "verify_k_samples",
                 format!("verify_k_samples × verify_s_samples = {grid}; at most 1e7"),

@@ -1215,35 +1215,15 @@ fn a_small_move_from_a_resting_start_slides_along_the_straight_trajectory() {
 fn a_problem_scaled_by_a_power_of_two_plans_the_same_bit_for_bit() {
     use dlo_planner::planner::observer::Silent;
     let (text, _) = planar_planner(13, 2);
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert!(v["rod"].get("weight_per_length").is_none());
+    // Lengths and the flexural rigidity times `scale` (`plan_suite --units`).
     let plan = |scale: f64| {
-        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let times = |x: &mut serde_json::Value| *x = (x.as_f64().unwrap() * scale).into();
-        for key in ["length", "radius", "flexural_rigidity"] {
-            times(&mut v["rod"][key]);
-        }
-        assert!(v["rod"].get("weight_per_length").is_none());
-        for o in v["obstacles"].as_array_mut().unwrap() {
-            o["position"]
-                .as_array_mut()
-                .unwrap()
-                .iter_mut()
-                .for_each(times);
-            let shape = o["shape"].as_object_mut().unwrap();
-            for (key, value) in shape.iter_mut() {
-                match value {
-                    serde_json::Value::Array(a) => a.iter_mut().for_each(times),
-                    serde_json::Value::Number(_) => times(value),
-                    _ => assert_eq!(key, "type"),
-                }
-            }
-        }
-        for end in ["start", "goal"] {
-            for key in ["x", "z"] {
-                times(&mut v["plan"][end][key]);
-            }
-        }
-        let c = dlo_planner::case::parse(&v.to_string(), std::path::Path::new("scaled.json"))
-            .expect("a scaled case");
+        let c = dlo_planner::case::parse(
+            &in_units(&text, scale, scale),
+            std::path::Path::new("scaled.json"),
+        )
+        .expect("a scaled case");
         let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
         p.run(&mut Silent)
     };
