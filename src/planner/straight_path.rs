@@ -69,14 +69,21 @@ impl Planner {
                 .all(|(a, b)| (a - b).abs() <= STATIONARY)
     }
 
-    /// Where an end shape rests on an obstacle (closer to it than the safety margin, which no
-    /// path can then keep next to that end) and the straight path peaks at an end shape but
-    /// does not keep the margin: the equilibria along the straight path's trajectory (the end
-    /// moved through the straight path's end poses, the rod sliding over the obstacle), judged
-    /// as the plan when they are executable and peak within `energy_gap_tolerance` of the lower
-    /// bound on `U_max` (the larger end energy): no path peaks lower by more than that, and the
-    /// gripper follows the straight path's end poses. `None` otherwise (the replay's shapes are
-    /// then dropped, not logged).
+    /// The equilibria along the straight path's trajectory (the end moved through the straight
+    /// path's end poses), judged as the plan before any optimisation when they are executable
+    /// and peak within `energy_gap_tolerance` of the lower bound on `U_max` (the larger end
+    /// energy): no path peaks lower by more than that, and the gripper follows the straight
+    /// path's end poses. Tried where the straight path peaks at an end shape and either
+    ///
+    /// - an end shape rests on an obstacle (closer to it than the safety margin, which no path
+    ///   can then keep next to that end) and the straight path does not keep the margin: the
+    ///   rod slides over the obstacle; or
+    /// - the straight path keeps every clearance ([`Self::straight_path_attains_bound`]) but
+    ///   departs from its replay (a heavy cable, whose interpolated shapes are not the
+    ///   equilibria its end poses produce): the equilibria must then keep the safety margin
+    ///   from every obstacle too, as the optimiser's shapes would.
+    ///
+    /// `None` otherwise (the replay's shapes are then dropped, not logged).
     pub(super) fn straight_trajectory_plan(
         &self,
         straight: &Verification,
@@ -92,7 +99,8 @@ impl Planner {
         }
         // The end shapes' clearances ([`Planner::end_clearances`]).
         let margin = self.safety() * self.base.model.rod.length;
-        if !ends.iter().any(|e| e.clearance < margin) {
+        let resting = ends.iter().any(|e| e.clearance < margin);
+        if !resting && !self.straight_path_attains_bound(straight) {
             return None;
         }
         let mut judged = self.judge_straight_trajectory(fine, observer);
@@ -103,14 +111,23 @@ impl Planner {
             .max(self.goal.energy.internal());
         let e = judged.equilibrium_plan.as_mut()?;
         let near = bound + self.settings.energy_gap_tolerance * bound.abs();
-        if !(judged.executable && (attains_end_energy(e.u_max, bound) || e.u_max <= near)) {
+        let keeps_margin = e.min_clearance.is_none_or(|c| c >= margin);
+        if !(judged.executable
+            && (attains_end_energy(e.u_max, bound) || e.u_max <= near)
+            && (resting || keeps_margin))
+        {
             return None;
         }
-        e.optimal_path_not_executable = Some(
+        e.optimal_path_not_executable = Some(if resting {
             "the straight-line path comes within the safety margin of an obstacle an end shape \
              rests on; the optimiser did not run"
-                .into(),
-        );
+                .into()
+        } else {
+            "the straight-line path attains the lower bound on U_max but departs from its \
+             replay, whose equilibria attain it too and keep the safety margin; the optimiser \
+             did not run"
+                .into()
+        });
         Some(judged)
     }
 

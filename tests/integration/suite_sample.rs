@@ -505,14 +505,62 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's 3D problem `spatial_1_5` (seed 1) as a heavy cable, 10 Rf/L³ per length (a
+/// cable that sags: a 1 m cable of 0.4 N/m and Rf = 0.04 N m²), with the defaults. Its
+/// straight-line path peaks at the start shape and keeps clear of the ball, but its shapes,
+/// interpolated coefficients, are not the equilibria a heavy cable takes, and its replay
+/// departs. The equilibria along its end poses are the plan without optimising: executable,
+/// peaking at the lower bound on U_max that every path meets (the larger end energy; within
+/// `energy_gap_tolerance`, 1 %), clear of the ball by more than the safety margin, and passing
+/// the same independent checks as every plan executed by its equilibria. (The optimiser's
+/// plan from the same problem peaks at the same bound and departs too: its replay ends on
+/// another equilibrium of the goal pose, 0.025 L from the goal shape, 2026-12-06.)
+#[test]
+fn a_heavy_cables_straight_trajectory_is_the_plan_where_its_equilibria_attain_the_bound() {
+    use dlo_planner::planner::observer::Silent;
+    let mut case: serde_json::Value = serde_json::from_str(&spatial_text(1, 68, 5)).expect("JSON");
+    case["rod"]["weight_per_length"] = 10.0.into();
+    let path = std::path::Path::new("planning_cases/spatial_1_5.json");
+    let c = dlo_planner::case::parse(&case.to_string(), path).expect("a generated case");
+    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(&mut Silent);
+    assert!(
+        r.optimiser.is_none() && r.starts.is_empty(),
+        "the optimiser ran"
+    );
+    assert!(!r.replay.coincide);
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    assert!(r.verdict().is_executable());
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none(), "{e:?}");
+    assert_eq!(e.trajectory, "straight_path");
+    let why = e.optimal_path_not_executable.as_deref().expect("a reason");
+    assert!(why.contains("departs from its replay"), "{why}");
+    // Every path passes through both end shapes: no plan peaks below the larger end energy.
+    let bound = p.start.energy.internal().max(p.goal.energy.internal());
+    assert!(
+        e.u_max >= bound - 1e-9 * bound.abs() && e.u_max <= bound + 0.01 * bound.abs(),
+        "U_max {} against the bound {bound}",
+        e.u_max
+    );
+    // Clear of the ball by the safety margin, on a grid four times finer in s.
+    let worst = held_on_the_trajectory_clear_of_obstacles(&p, &r);
+    let margin = p.safety() * p.base.model.rod.length;
+    assert!(
+        worst >= margin,
+        "{worst:.3e} against the margin {margin:.3e}"
+    );
+}
+
 /// The independent checks of a plan executed by its replayed equilibria: every replayed shape is
 /// held at the trajectory's pose (its end's position to 1e-9 L and its frame to 1e-9), converged
 /// and not unstable; the last one is the goal shape (within the coincidence tolerance); no shape
 /// comes closer to an obstacle than the rod's radius on a grid four times finer in s (−1e-6 L).
+/// Returns the smallest clearance on that grid (case units).
 fn held_on_the_trajectory_clear_of_obstacles(
     p: &dlo_planner::planner::Planner,
     r: &dlo_planner::planner::PlanResult,
-) {
+) -> f64 {
     use dlo_planner::planner::verify::fine_model;
     let model = &p.base.model;
     let l = model.rod.length;
@@ -560,6 +608,7 @@ fn held_on_the_trajectory_clear_of_obstacles(
         .map(|step| clearance_on(p, &fine, &step.a))
         .fold(f64::INFINITY, f64::min);
     assert!(worst >= -1e-6 * l, "a replayed shape is {worst:.3e} inside");
+    worst
 }
 
 /// The smallest surface gap (case units) between the obstacles of `p` and the shape of

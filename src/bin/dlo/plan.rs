@@ -468,7 +468,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 e.end, e.obstacle
             ),
             (None, None) if p.along_straight_trajectory() => {
-                "optimiser not run: an end shape rests on an obstacle, and the equilibria along the straight-line path's trajectory peak within the energy-gap tolerance of the lower bound on U_max".into()
+                "optimiser not run: the equilibria along the straight-line path's trajectory peak within the energy-gap tolerance of the lower bound on U_max".into()
             }
             (None, None) => "optimiser not run: the straight-line path attains the lower bound on U_max, the larger end energy".into(),
         }
