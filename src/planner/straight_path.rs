@@ -21,6 +21,11 @@ use crate::constraints::Constraint;
 /// the start's own pose lands on its shape to the last bits.
 const STATIONARY: f64 = 1e-12;
 
+/// Largest gripper path, over the straight-line distance between its start and goal
+/// positions, for which the equilibria along a straight path that departs from its replay are
+/// taken before optimising (the generated suite's target for the median plan).
+const STRAIGHT_ROUTE_TRAVEL: f64 = 3.0;
+
 impl Planner {
     /// Whether the straight path `straight` (its verification) attains the lower bound on
     /// `U_max` and keeps the optimiser's clearances, so that it is worth replaying as the plan:
@@ -109,15 +114,16 @@ impl Planner {
             .energy
             .internal()
             .max(self.goal.energy.internal());
-        let e = judged.equilibrium_plan.as_mut()?;
+        let e = judged.equilibrium_plan.as_ref()?;
         let near = bound + self.settings.energy_gap_tolerance * bound.abs();
         let keeps_margin = e.min_clearance.is_none_or(|c| c >= margin);
         if !(judged.executable
             && (attains_end_energy(e.u_max, bound) || e.u_max <= near)
-            && (resting || keeps_margin))
+            && (resting || (keeps_margin && self.straight_route_is_short(&judged))))
         {
             return None;
         }
+        let e = judged.equilibrium_plan.as_mut()?;
         e.optimal_path_not_executable = Some(if resting {
             "the straight-line path comes within the safety margin of an obstacle an end shape \
              rests on; the optimiser did not run"
@@ -129,6 +135,19 @@ impl Planner {
                 .into()
         });
         Some(judged)
+    }
+
+    /// Whether the gripper's path along the straight path's end poses, at the steps of
+    /// `judged`'s replay, is at most [`STRAIGHT_ROUTE_TRAVEL`] times the straight-line
+    /// distance between its start and goal positions: a route a robot would run. (The
+    /// coefficients' straight line can swing the end far round; the optimiser's travel term
+    /// then usually finds a shorter route at the same peak.)
+    fn straight_route_is_short(&self, judged: &Judged) -> bool {
+        let path = self.path();
+        let z = vec![0.0; path.n_vars()];
+        let ks: Vec<f64> = judged.replay.steps.iter().map(|s| s.k).collect();
+        let t = super::trajectory::Trajectory::along(&self.base.model, &path, &z, &ks);
+        t.path_length <= STRAIGHT_ROUTE_TRAVEL * t.straight_distance
     }
 
     /// The equilibria along the straight path's trajectory judged as the plan
