@@ -86,7 +86,8 @@ impl Planner {
     /// - the straight path keeps every clearance ([`Self::straight_path_attains_bound`]) but
     ///   departs from its replay (a heavy cable, whose interpolated shapes are not the
     ///   equilibria its end poses produce): the equilibria must then keep the safety margin
-    ///   from every obstacle too, as the optimiser's shapes would.
+    ///   from every obstacle too, as the optimiser's shapes would, and the gripper's route
+    ///   along them be short ([`Self::straight_route_is_short`]).
     ///
     /// `None` otherwise (the replay's shapes are then dropped, not logged).
     pub(super) fn straight_trajectory_plan(
