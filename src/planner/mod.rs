@@ -62,8 +62,8 @@ const END_GRID_REFINEMENT: usize = 4;
 /// The grid in s on which an end shape resting on an obstacle must be clear
 /// ([`END_GRID_REFINEMENT`] times the verification grid's intervals in s,
 /// [`Planner::verify_s_intervals`]).
-fn end_grid(model: &crate::rod::model::Model, verify_s_samples: usize) -> crate::rod::model::Model {
-    fine_model(model, END_GRID_REFINEMENT * verify_s_samples, 2)
+fn end_grid(model: &crate::rod::model::Model, s_intervals: usize) -> crate::rod::model::Model {
+    fine_model(model, END_GRID_REFINEMENT * s_intervals, 2)
 }
 
 /// Largest margin (a fraction of the coincidence tolerance) by which replayed equilibria that
@@ -1087,8 +1087,8 @@ impl Planner {
         self.end_inside_obstacle(&self.end_clearances())
     }
 
-    /// The grid the end shapes are checked on: the one the planner was made with, or where
-    /// `verify_s_samples` has changed since, one made for it ([`end_grid`]).
+    /// The grid the end shapes are checked on: the one the planner was made with, or where the
+    /// verification grid's intervals in s have changed since, one made for them ([`end_grid`]).
     fn end_check_grid(&self) -> Arc<(usize, crate::rod::model::Model)> {
         let n = self.verify_s_intervals();
         if self.end_grid.0 == n {

@@ -358,15 +358,17 @@ fn suite_3d_plan(
     suite_3d_plan_observed(
         i,
         serde_json::json!({}),
+        serde_json::json!({}),
         &mut dlo_planner::planner::observer::Silent,
     )
 }
 
 /// [`suite_3d_plan`], telling `observer` of the run, with `plan` (a JSON object) merged into
-/// the case's `plan` section.
+/// the case's `plan` section and `fields` into the case ([`merge`], as `plan_suite --case`).
 fn suite_3d_plan_observed(
     i: usize,
     plan: serde_json::Value,
+    fields: serde_json::Value,
     observer: &mut dyn dlo_planner::planner::observer::PlanObserver,
 ) -> (
     dlo_planner::planner::Planner,
@@ -379,6 +381,7 @@ fn suite_3d_plan_observed(
     for (k, v) in plan.as_object().expect("an object") {
         case["plan"][k] = v.clone();
     }
+    merge(&mut case, &fields);
     let path = format!("planning_cases/spatial_{i}.json");
     let c = case::parse(&case.to_string(), std::path::Path::new(&path)).expect("a generated case");
     let p = Planner::from_case(&c).expect("start and goal solve");
@@ -475,7 +478,7 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
     }
     let mut logged = Optimal(Vec::new());
     let always_optimise = serde_json::json!({ "straight_path_first": false });
-    let (p, r) = suite_3d_plan_observed(12, always_optimise, &mut logged);
+    let (p, r) = suite_3d_plan_observed(12, always_optimise, serde_json::json!({}), &mut logged);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");
@@ -518,12 +521,8 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
 #[test]
 fn a_heavy_cables_straight_trajectory_is_the_plan_where_its_equilibria_attain_the_bound() {
     use dlo_planner::planner::observer::Silent;
-    let mut case: serde_json::Value = serde_json::from_str(&spatial_text(1, 68, 5)).expect("JSON");
-    case["rod"]["weight_per_length"] = 10.0.into();
-    let path = std::path::Path::new("planning_cases/spatial_1_5.json");
-    let c = dlo_planner::case::parse(&case.to_string(), path).expect("a generated case");
-    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
-    let r = p.run(&mut Silent);
+    let heavy = serde_json::json!({"rod": {"weight_per_length": 10.0}});
+    let (p, r) = suite_3d_plan_observed(5, serde_json::json!({}), heavy, &mut Silent);
     assert!(
         r.optimiser.is_none() && r.starts.is_empty(),
         "the optimiser ran"
