@@ -94,6 +94,10 @@ def test_case_fields(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(text))
     assert field_of(lambda: dlo.Case.load(bad)) == "rod.length"
+    text["rod"]["length"] = 1.0
+    text["rod"]["flexural_rigidity"] = [1.0, 2.0]
+    bad.write_text(json.dumps(text))
+    assert field_of(lambda: dlo.Case.load(bad)) == "rod.flexural_rigidity"
     with pytest.raises(dlo.InputError) as err:
         dlo.Case.parse("{ not json")
     assert err.value.field is None

@@ -17,17 +17,8 @@ impl Grasp {
                 "missing: `dlo margin` needs a `grasp` section".into(),
             ));
         };
-        let settings: GraspSettings = serde_json::from_value(raw.clone()).map_err(|e| {
-            let message = e.to_string();
-            if message.contains("untagged enum Directions") {
-                err(
-                    "grasp.directions".into(),
-                    "a count or a list of vectors of numbers".into(),
-                )
-            } else {
-                err("grasp".into(), message)
-            }
-        })?;
+        let settings: GraspSettings = super::field_path::read(raw.clone())
+            .map_err(|(field, e)| err(super::field_path::join("grasp", &field), e.to_string()))?;
         let problem = GraspProblem {
             statics: case.builder.clone(),
             initial: case.initial.clone(),

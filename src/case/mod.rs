@@ -3,6 +3,7 @@
 //! README with its units and default. Lengths, forces and rigidities are in any one consistent
 //! unit system; angles in radians.
 
+mod field_path;
 pub mod frame;
 pub mod grasp;
 mod limits;
@@ -167,7 +168,10 @@ impl Default for BaseSpec {
 
 /// One coordinate of a position constraint: a number means equality.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a number (equality) or bounds `{\"min\": a, \"max\": b}` (either may be left out)"
+)]
 pub enum CoordSpec {
     /// `x_k = v`.
     Equal(f64),
@@ -425,22 +429,32 @@ pub fn load(path: &Path) -> Result<Case, Error> {
 
 /// Parses and validates case text; `path` names it in errors and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
-    let file: CaseFile = serde_json::from_str(text).map_err(|e| {
-        // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
-        // message for an array ("expected struct CaseFile with 16 elements") names nothing
-        // a user wrote.
-        let first = text.trim_start().chars().next();
-        let message = match first {
-            Some(c) if c != '{' && e.classify() == serde_json::error::Category::Data => {
-                format!("a case file is a JSON object (`{{ \"rod\": …, … }}`); this one starts with `{c}`")
+    let mut de = serde_json::Deserializer::from_str(text);
+    let file: CaseFile = field_path::read(&mut de)
+        .and_then(|file| de.end().map(|()| file).map_err(|e| (String::new(), e)))
+        .map_err(|(field, e)| {
+            // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
+            // message for an array ("expected struct CaseFile with 16 elements") names nothing
+            // a user wrote.
+            let first = text.trim_start().chars().next();
+            let data = e.classify() == serde_json::error::Category::Data;
+            let message = match first {
+                Some(c) if c != '{' && data => {
+                    format!("a case file is a JSON object (`{{ \"rod\": …, … }}`); this one starts with `{c}`")
+                }
+                _ => e.to_string(),
+            };
+            // A value of the wrong kind is reported at its field (the message keeps the line
+            // and column); a file that is not JSON, at its line and column.
+            if data && !field.is_empty() {
+                Error::invalid(path, field, message)
+            } else {
+                Error::Parse {
+                    path: path.to_path_buf(),
+                    message,
+                }
             }
-            _ => e.to_string(),
-        };
-        Error::Parse {
-            path: path.to_path_buf(),
-            message,
-        }
-    })?;
+        })?;
     build(file, path)
 }
 

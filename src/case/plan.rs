@@ -9,7 +9,10 @@ use serde::Deserialize;
 
 /// A start or goal: the controlled end's pose (solved as a static shape), or coefficients.
 #[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an object: the end's pose (`position` or `x`, `y`, `z`, and its orientation) or its `shape`"
+)]
 pub struct EndSpec {
     /// x of `P(L)`.
     pub x: Option<f64>,
@@ -162,7 +165,8 @@ pub fn plan_section(case: &Case) -> Result<(End, End, PlanSettings), Error> {
         .plan
         .clone()
         .ok_or_else(|| v.err("plan", "missing: `dlo plan` needs a `plan` section"))?;
-    let (start, goal, settings) = split(raw).map_err(|e| v.err("plan", e))?;
+    let (start, goal, settings) =
+        split(raw).map_err(|(field, e)| v.err(super::field_path::join("plan", &field), e))?;
     let model = &case.problem.model;
     let layout = model.layout;
     if layout.free_base {
@@ -290,21 +294,23 @@ pub fn plan_section(case: &Case) -> Result<(End, End, PlanSettings), Error> {
     Ok((start, goal, settings))
 }
 
-/// The section's `start` and `goal`, and its other keys as settings.
-fn split(raw: serde_json::Value) -> Result<(EndSpec, EndSpec, PlanSettings), String> {
+/// The section's `start` and `goal`, and its other keys as settings; an error names the field
+/// inside the section it is at (empty: the section itself).
+fn split(raw: serde_json::Value) -> Result<(EndSpec, EndSpec, PlanSettings), (String, String)> {
+    use super::field_path::{join, read};
     let serde_json::Value::Object(mut map) = raw else {
-        return Err("must be an object".into());
+        return Err((String::new(), "must be an object".into()));
     };
-    let mut take = |key: &str| -> Result<EndSpec, String> {
+    let mut take = |key: &str| -> Result<EndSpec, (String, String)> {
         let value = map
             .remove(key)
-            .ok_or_else(|| format!("missing field `{key}`"))?;
-        serde_json::from_value(value).map_err(|e| format!("{key}: {e}"))
+            .ok_or_else(|| (String::new(), format!("missing field `{key}`")))?;
+        read(value).map_err(|(field, e)| (join(key, &field), e.to_string()))
     };
     let start = take("start")?;
     let goal = take("goal")?;
     let settings =
-        serde_json::from_value(serde_json::Value::Object(map)).map_err(|e| e.to_string())?;
+        read(serde_json::Value::Object(map)).map_err(|(field, e)| (field, e.to_string()))?;
     Ok((start, goal, settings))
 }
 

@@ -35,7 +35,10 @@ pub struct GraspProblem {
 /// Disturbance directions: a number spread evenly in the x–z plane, or explicit vectors
 /// `[n_z, n_x]` (planar, the paper's order) / `[n_x, n_y, n_z]` (3D).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a count or a list of vectors of numbers"
+)]
 pub enum Directions {
     /// Evenly spread directions.
     Count(u64),

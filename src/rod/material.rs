@@ -5,7 +5,10 @@ use serde::{Deserialize, Serialize};
 /// A material property along the rod: constant, or linear in `s` (the paper's trapezoidal strip,
 /// §5.1, has rigidity and weight linear in `s`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a number, or `{\"start\": a, \"end\": b}` (linear in s)"
+)]
 pub enum Profile {
     /// The same value everywhere.
     Constant(f64),

@@ -59,7 +59,21 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
         (
             "wrong type",
             c(r#""rod": {"length": "long", "flexural_rigidity": 1.0}"#),
-            "invalid type",
+            "field `rod.length`: invalid type: string \"long\", expected f64 at line 1",
+        ),
+        (
+            "profile of the wrong kind",
+            c(r#""rod": {"length": 1.0, "flexural_rigidity": [1.0, 2.0]}"#),
+            "field `rod.flexural_rigidity`: expected a number, or `{\"start\": a, \"end\": b}`",
+        ),
+        // (A constraint is tagged by its `type`, so the path ends at the entry; the line and
+        // column point into it.)
+        (
+            "coordinate of the wrong kind",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 0.0, "x": "left"}}]"#
+            )),
+            "field `constraints[0]`: expected a number (equality) or bounds `{\"min\": a, \"max\": b}`",
         ),
         (
             "negative length",
@@ -118,7 +132,7 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             c(&format!(
                 r#"{GOOD_ROD}, "constraints": [{{"type": "glue", "s": 1.0}}]"#
             )),
-            "unknown variant `glue`",
+            "field `constraints[0].type`: unknown variant `glue`",
         ),
         (
             "y on planar rod",
@@ -186,7 +200,7 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             c(&format!(
                 r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "torus", "radius": 1.0}}}}]"#
             )),
-            "unknown variant `torus`",
+            "field `obstacles[0].shape.type`: unknown variant `torus`",
         ),
         (
             "zero half-space normal",
@@ -273,7 +287,7 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             c(&format!(
                 r#"{GOOD_ROD}, "discretisation": {{"basis": "chebyshev"}}"#
             )),
-            "unknown variant `chebyshev`, expected `paper` or `legendre`",
+            "field `discretisation.basis`: unknown variant `chebyshev`, expected `paper` or `legendre`",
         ),
     ]
 }
@@ -397,6 +411,42 @@ fn plan_margin_and_log_commands_reject_bad_input() {
     let (code, _, err) = run(&["margin", no_plan.to_str().unwrap(), "--log-dir", logs_s]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("field `grasp`"), "{err}");
+    // A value of the wrong kind inside the plan and grasp sections is reported at its field.
+    let held = r#""rod": {"length": 1.0, "flexural_rigidity": 1.0},
+        "constraints": [{"type": "orientation", "s": 0.0, "theta": 0.0}]"#;
+    for (section, needle) in [
+        (
+            r#""plan": {"start": {"x": 0.3, "z": 0.9}, "goal": "up"}"#,
+            "field `plan.goal`: invalid type: string \"up\", expected an object: the end's pose",
+        ),
+        (
+            r#""plan": {"start": {"position": [0.3, 0, "high"]}, "goal": {"x": -0.3, "z": 0.9}}"#,
+            "field `plan.start.position[2]`: invalid type: string \"high\"",
+        ),
+        (
+            r#""plan": {"start": {"x": 0.3, "z": 0.9}, "goal": {"x": -0.3, "z": 0.9}, "sharpness": [10, "x"]}"#,
+            "field `plan.sharpness[1]`: invalid type: string \"x\"",
+        ),
+        (
+            r#""grasp": {"directions": "all"}"#,
+            "field `grasp.directions`: expected a count or a list of vectors of numbers",
+        ),
+    ] {
+        let case = dir.join("wrong_kind.json");
+        std::fs::write(&case, format!("{{{held}, {section}}}")).unwrap();
+        let cmd = if section.contains("grasp") {
+            "margin"
+        } else {
+            "plan"
+        };
+        let (code, out, err) = run(&[cmd, case.to_str().unwrap(), "--log-dir", logs_s]);
+        assert_eq!(code, 2, "{err}");
+        assert!(out.is_empty(), "{out}");
+        assert!(
+            err.contains("wrong_kind.json") && err.contains(needle),
+            "{needle}: {err}"
+        );
+    }
     let m0 = dir.join("m0.json");
     std::fs::write(
         &m0,
