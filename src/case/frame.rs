@@ -80,7 +80,7 @@ impl<'de> serde::Deserialize<'de> for AngleFrameSpec {
             .map(AngleFrameSpec::Matrix)
             .map_err(|_| {
                 serde::de::Error::custom(
-                    "angle_frame: expected \"auto\", \"case\" or a 3×3 rotation matrix (three rows of three numbers)",
+                    "expected \"auto\", \"case\" or a 3×3 rotation matrix (three rows of three numbers)",
                 )
             })
     }

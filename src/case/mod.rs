@@ -30,7 +30,10 @@ use std::sync::Arc;
 
 /// The case file as written.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a case file: an object with the `rod` and what else the case has"
+)]
 pub struct CaseFile {
     /// Case name (default: the file stem); names the log file.
     pub name: Option<String>,
@@ -86,7 +89,10 @@ fn yes() -> bool {
 
 /// `rod` section.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an object with the rod's `length`, `flexural_rigidity` and the other properties it has"
+)]
 pub struct RodSpec {
     /// Natural length `L` (> 0).
     pub length: f64,
@@ -104,7 +110,11 @@ pub struct RodSpec {
 
 /// `discretisation` section.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(
+    deny_unknown_fields,
+    default,
+    expecting = "an object of discretisation settings (`basis_pairs`, `panels`, …)"
+)]
 pub struct DiscretisationSpec {
     /// Sine/cosine pairs per field (paper: 4, i.e. 10 functions).
     pub basis_pairs: usize,
@@ -149,7 +159,11 @@ impl Default for DiscretisationSpec {
 
 /// `base` section.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(
+    deny_unknown_fields,
+    default,
+    expecting = "an object `{\"position\": [x, y, z], \"free\": false}`"
+)]
 pub struct BaseSpec {
     /// Position of `P(0)` (the start when free).
     pub position: [f64; 3],
@@ -181,7 +195,7 @@ pub enum CoordSpec {
 
 /// One-sided bounds on a coordinate.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "bounds `{\"min\": a, \"max\": b}`")]
 pub struct RangeSpec {
     /// `x_k ≥ min`.
     pub min: Option<f64>,
@@ -240,7 +254,10 @@ pub enum ConstraintSpec {
 
 /// A point force.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a point load `{\"s\": s, \"force\": [fx, fy, fz], \"reference\": [x, y, z]}`"
+)]
 pub struct ForceSpec {
     /// Arc length of the point of application.
     pub s: f64,
@@ -253,7 +270,10 @@ pub struct ForceSpec {
 
 /// An obstacle entry.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an obstacle: an object with its `shape` (and `name`, `position`, `rotation`)"
+)]
 pub struct ObstacleSpec {
     /// Name in reports and logs.
     pub name: Option<String>,
@@ -326,7 +346,10 @@ fn one() -> f64 {
 
 /// Explicit Ritz coefficients (basis `1, s/L, sin(2πis/L), cos(2πis/L)`).
 #[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "Ritz coefficients `{\"theta\": [...], \"phi\": [...], \"psi\": [...], \"eps\": [...]}`"
+)]
 pub struct ShapeSpec {
     /// φ coefficients.
     pub phi: Option<Vec<f64>>,

@@ -48,7 +48,11 @@ pub enum Directions {
 
 /// Settings of a margin computation: the case file's `grasp` section.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(
+    deny_unknown_fields,
+    default,
+    expecting = "an object of grasp settings (`points`, `directions`, …)"
+)]
 pub struct GraspSettings {
     /// Pinch preload `r0` (case force units); required when the grasp has a pinch.
     pub preload: Option<f64>,

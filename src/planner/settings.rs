@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// section (`docs/case-files.md` documents them); [`Default`] gives the defaults a case file
 /// gets.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields, default, expecting = "an object of plan settings")]
 pub struct PlanSettings {
     /// Path terms `m` (paper: 3).
     pub path_terms: usize,
@@ -136,7 +136,10 @@ pub struct PlanSettings {
 /// An axis-aligned box the controlled end's position must stay in: `min ≤ x(L) ≤ max` per
 /// component, in case units and axes; a `null` component is unbounded.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "bounds on the controlled end `{\"min\": [x, y, z], \"max\": [x, y, z]}`"
+)]
 pub struct Workspace {
     /// Lower bounds (x, y, z).
     #[serde(default)]

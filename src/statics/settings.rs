@@ -8,7 +8,11 @@ use serde::{Deserialize, Serialize};
 
 /// Settings of a static solve: the case file's `solver` section.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(
+    deny_unknown_fields,
+    default,
+    expecting = "an object of solver settings (`feasibility_tol`, `max_outer`, …)"
+)]
 pub struct StaticSettings {
     /// Constraint violation tolerance (positions in units of `L`).
     pub feasibility_tol: f64,

@@ -62,6 +62,11 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             "field `rod.length`: invalid type: string \"long\", expected f64 at line 1",
         ),
         (
+            "rod of the wrong kind",
+            c(r#""rod": null"#),
+            "field `rod`: invalid type: null, expected an object with the rod's `length`",
+        ),
+        (
             "profile of the wrong kind",
             c(r#""rod": {"length": 1.0, "flexural_rigidity": [1.0, 2.0]}"#),
             "field `rod.flexural_rigidity`: expected a number, or `{\"start\": a, \"end\": b}`",
@@ -259,7 +264,7 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
         (
             "unknown angle frame",
             c(&format!(r#"{GOOD_ROD}, "angle_frame": "sideways""#)),
-            "angle_frame: expected \"auto\", \"case\" or a 3×3 rotation matrix",
+            "field `angle_frame`: expected \"auto\", \"case\" or a 3×3 rotation matrix",
         ),
         (
             "angle frame not a rotation",
