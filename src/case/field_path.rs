@@ -30,6 +30,56 @@ pub(crate) fn join(prefix: &str, path: &str) -> String {
     }
 }
 
+/// The error of a case file's `text` (at `path`) that failed at the field `field` (empty: the
+/// top level) with `e`: a value of the wrong kind, at its field (its message keeps the line and
+/// column); text that is not JSON, or JSON that is not an object, as a whole.
+pub(crate) fn file_error(
+    text: &str,
+    path: &std::path::Path,
+    field: String,
+    e: serde_json::Error,
+) -> crate::error::Error {
+    use crate::error::Error;
+    // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
+    // message for an array ("expected struct CaseFile with 16 elements") names nothing
+    // a user wrote.
+    let first = text.trim_start().chars().next();
+    let mut data = e.classify() == serde_json::error::Category::Data;
+    let mut message = e.to_string();
+    // In text that is JSON, serde_json reports two kinds of value as syntax errors: a
+    // name (`"basis": "paper"`) given as a value of another kind ("expected value"),
+    // and a list with more items than its field takes ("trailing characters"). They
+    // are data.
+    if !data && !field.is_empty() && serde_json::from_str::<serde_json::Value>(text).is_ok() {
+        data = true;
+        let what = if message.starts_with("expected value") {
+            "expected a name (a string), got a value of another kind"
+        } else if message.starts_with("trailing characters") {
+            "more items than this field takes"
+        } else {
+            "a value of the wrong kind"
+        };
+        message = format!("{what} at line {} column {}", e.line(), e.column());
+    }
+    let object = first.is_none_or(|c| c == '{');
+    if !object && data {
+        message = format!(
+            "a case file is a JSON object (`{{ \"rod\": …, … }}`); this one starts with `{}`",
+            first.unwrap_or_default()
+        );
+    }
+    // A value of the wrong kind is reported at its field (the message keeps the line
+    // and column); a file that is not JSON, or not an object, as a whole.
+    if object && data && !field.is_empty() {
+        Error::invalid(path, field, message)
+    } else {
+        Error::Parse {
+            path: path.to_path_buf(),
+            message,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

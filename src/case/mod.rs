@@ -455,29 +455,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
     let mut de = serde_json::Deserializer::from_str(text);
     let file: CaseFile = field_path::read(&mut de)
         .and_then(|file| de.end().map(|()| file).map_err(|e| (String::new(), e)))
-        .map_err(|(field, e)| {
-            // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
-            // message for an array ("expected struct CaseFile with 16 elements") names nothing
-            // a user wrote.
-            let first = text.trim_start().chars().next();
-            let data = e.classify() == serde_json::error::Category::Data;
-            let message = match first {
-                Some(c) if c != '{' && data => {
-                    format!("a case file is a JSON object (`{{ \"rod\": …, … }}`); this one starts with `{c}`")
-                }
-                _ => e.to_string(),
-            };
-            // A value of the wrong kind is reported at its field (the message keeps the line
-            // and column); a file that is not JSON, at its line and column.
-            if data && !field.is_empty() {
-                Error::invalid(path, field, message)
-            } else {
-                Error::Parse {
-                    path: path.to_path_buf(),
-                    message,
-                }
-            }
-        })?;
+        .map_err(|(field, e)| field_path::file_error(text, path, field, e))?;
     build(file, path)
 }
 

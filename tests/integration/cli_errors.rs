@@ -67,6 +67,18 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             "field `rod`: invalid type: null, expected an object with the rod's `length`",
         ),
         (
+            "name of the wrong kind",
+            c(&format!(r#"{GOOD_ROD}, "discretisation": {{"basis": []}}"#)),
+            "field `discretisation.basis`: expected a name (a string), got a value of another kind",
+        ),
+        (
+            "list too long",
+            c(&format!(
+                r#"{GOOD_ROD}, "base": {{"position": [0, 0, 0, 1]}}"#
+            )),
+            "field `base.position`: more items than this field takes at line 1",
+        ),
+        (
             "profile of the wrong kind",
             c(r#""rod": {"length": 1.0, "flexural_rigidity": [1.0, 2.0]}"#),
             "field `rod.flexural_rigidity`: expected a number, or `{\"start\": a, \"end\": b}`",

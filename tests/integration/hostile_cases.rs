@@ -142,8 +142,9 @@ fn apply(base: &Value, edits: &[Edit]) -> Value {
 }
 
 /// Reads, validates and evaluates `text` as a case at `path`; fails on a panic or an error that
-/// does not name the file.
-fn check(text: &str, path: &Path) -> Result<(), TestCaseError> {
+/// does not name the file, or (`json`: the text is JSON) that names neither a field nor what
+/// is wrong with the file as a whole (a required section missing, not an object).
+fn check(text: &str, path: &Path, json: bool) -> Result<(), TestCaseError> {
     CHECKED.fetch_add(1, Relaxed);
     let named = |e: &dyn std::fmt::Display| {
         let m = e.to_string();
@@ -151,7 +152,18 @@ fn check(text: &str, path: &Path) -> Result<(), TestCaseError> {
         Ok(())
     };
     match case::parse(text, path) {
-        Err(e) => named(&e)?,
+        Err(e) => {
+            named(&e)?;
+            if json && !matches!(e, dlo_planner::Error::Invalid { .. }) {
+                let m = e.to_string();
+                prop_assert!(
+                    ["missing field", "a case file is a JSON object"]
+                        .iter()
+                        .any(|w| m.contains(w)),
+                    "JSON of the wrong kind not named by its field: {m}"
+                );
+            }
+        }
         Ok(c) => {
             VALID.fetch_add(1, Relaxed);
             if c.plan.is_some()
@@ -206,7 +218,7 @@ fn edited_case_files_never_panic_and_errors_name_the_file() {
     run_batches("edited cases", strategy, |(k, edits)| {
         let (path, base) = &cases[k];
         let v = apply(base, &edits);
-        check(&v.to_string(), path)
+        check(&v.to_string(), path, true)
     });
 }
 
@@ -230,6 +242,6 @@ fn cut_and_spliced_case_text_never_panics() {
         let mut t: String = chars[..a].iter().collect();
         t.extend(ins);
         t.extend(&chars[b..]);
-        check(&t, path)
+        check(&t, path, false)
     });
 }
