@@ -1,6 +1,6 @@
 //! Case files: JSON parsed with serde into typed values (`deny_unknown_fields`), then validated
-//! once into a [`Case`] holding a ready [`StaticProblem`]. Every field is documented in the
-//! README with its units and default. Lengths, forces and rigidities are in any one consistent
+//! once into a [`Case`] holding a ready [`StaticProblem`]. Every field is documented in
+//! docs/case-files.md with its units and default. Lengths, forces and rigidities are in any one consistent
 //! unit system; angles in radians.
 
 mod field_path;
@@ -245,7 +245,7 @@ pub enum ConstraintSpec {
         theta: Option<f64>,
         /// ψ (spatial only).
         psi: Option<f64>,
-        /// φ + ψ (spatial only; instead of φ and ψ, see the README).
+        /// φ + ψ (spatial only; instead of φ and ψ, see docs/case-files.md).
         phi_plus_psi: Option<f64>,
         /// Label in reports.
         name: Option<String>,

@@ -4,7 +4,7 @@
 //!
 //! where `S_β(u) = u_max + ln Σ exp(β (u_j − u_max)) / β` is the log-sum-exp smoothed maximum
 //! (an upper bound on `max u` by at most `ln(K+1)/β`) and `w ≥ 0` weighs the mean energy along
-//! the path (see the README: it makes the shapes away from the maximum equilibria too).
+//! the path (it makes the shapes away from the maximum equilibria too; docs/algorithms.md, step 4).
 //! With tracking targets `x̄_j` set (the equilibria the controlled end's poses produce, see
 //! [`crate::planner::Planner`]), `J` also has `(w_eq/2) · Σ_j mean_b |x_b(a(z,k_j)) − x̄_jb|²`,
 //! which pulls every sampled shape onto the equilibrium its own end pose gives.

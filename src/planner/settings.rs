@@ -35,7 +35,7 @@ pub struct PlanSettings {
     /// Extra clearance (case length units) the optimiser keeps from obstacles, so that the path
     /// between its samples stays clear. Default `L/100`.
     pub safety_margin: Option<f64>,
-    /// Weight of the mean energy along the path in the objective (see the README).
+    /// Weight of the mean energy along the path in the objective (docs/algorithms.md, step 4).
     pub mean_weight: f64,
     /// Weight of the controlled end's travel in the objective, `½ w ∫ |dx/dk|² dk` with `x` in
     /// units of `L` (energies are in `Rf/L`): a tie-break that keeps the gripper's path short
@@ -512,8 +512,8 @@ pub fn env_threads() -> Result<Option<usize>, String> {
     }
 }
 
-/// Inner minimiser of the path optimisation's sharpness stages (see the README for what each
-/// finds); the equilibrium-tracking rounds always take Newton steps.
+/// Inner minimiser of the path optimisation's sharpness stages (docs/notes/speed-alternatives.md
+/// says what each finds); the equilibrium-tracking rounds always take Newton steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Optimiser {
@@ -548,8 +548,8 @@ fn d_mean() -> f64 {
     1.0
 }
 fn d_track() -> f64 {
-    // With 1000 and three rounds, 7 of 24 random planar start–goal pairs coincided; with this
-    // and eight, 14 (every one of the 7 among them; see the README).
+    // A stronger pull, with more rounds, makes more planar plans coincide with their replay
+    // (docs/notes/plan-settings.md).
     10_000.0
 }
 fn d_rounds() -> usize {

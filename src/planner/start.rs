@@ -359,7 +359,7 @@ impl Planner {
                 p.peaks_at_an_end()
             });
         // Equilibrium tracking: pull every sampled shape onto the equilibrium its end pose
-        // produces (see the README for why the paper's objective alone does not).
+        // produces (docs/algorithms.md, step 4, says why the paper's objective alone does not).
         let (tracking_rounds, tracking_rounds_kept, equilibrium_deviation) = if settled
             && !matches!(
                 tally.status,

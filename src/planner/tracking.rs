@@ -1,6 +1,7 @@
 //! Equilibrium tracking: after the sharpness stages, the planner replays its own samples (the
 //! equilibria their end poses produce) and pulls each sampled shape onto that equilibrium by a
-//! term in the objective, re-optimising, round after round while it helps (see the README).
+//! term in the objective, re-optimising, round after round while it helps (docs/algorithms.md,
+//! step 4).
 
 use super::minimax::MinimaxProblem;
 use super::start::Tally;
