@@ -17,13 +17,12 @@ pub struct PlanSettings {
     /// executable. Default (absent): `[6, 8]` on a planar rod, none
     /// on a 3D rod (see [`PlanSettings::fallback_terms`]).
     pub fallback_path_terms: Option<Vec<usize>>,
-    /// Objective evaluations each start of an attempt after the case's own (a fallback's, or
-    /// the last one's without the travel term) may use: its sharpness stages, tracking
-    /// rounds and sample refinements stop once it has (checked between them), and its status
-    /// is then `iteration_limit`. On the generated suite (the 66 planar problems of 26 seeds
-    /// that reach the fallbacks) the 53 executable plans that came from a budgeted start used
-    /// at most 8,463 evaluations but for two whose last stage ran past the budget (about
-    /// 20,500); without the budget, fallbacks that found nothing ran to 50,000.
+    /// Objective evaluations each start of the planar quick attempt and of an attempt after
+    /// the case's own (a lifted plan, a fallback's, or the last one's without the travel term)
+    /// may use: its sharpness stages, tracking rounds and sample refinements stop once it has
+    /// (checked between them), and its status is then `iteration_limit`. It bounds what a
+    /// search that finds nothing spends in those attempts; the plans they found on the
+    /// generated suite used less (docs/notes/plan-settings.md).
     pub fallback_evaluations: usize,
     /// Samples of `k` seen by the optimiser, including 0 and 1.
     pub k_samples: usize,
@@ -414,11 +413,9 @@ impl PlanSettings {
     }
 
     /// The path-term counts tried after `path_terms`: `fallback_path_terms`, or by default
-    /// `[6, 8]` on a planar rod and none on a 3D one. On the generated suite's planar problems
-    /// (seed 1) the fallbacks raised the executable plans from 39 to 53 of 60 at less than twice
-    /// the median plan time (measured before the replayed equilibria's clearance was checked on
-    /// the verification grid in s, which leaves 49); on the 3D problems they
-    /// multiply the plan time several times over.
+    /// `[6, 8]` on a planar rod and none on a 3D one: more terms let a planar path's shapes
+    /// reach their equilibria where three cannot, while on a 3D rod they multiply the plan
+    /// time several times over (docs/notes/plan-settings.md).
     pub fn fallback_terms(&self, spatial: bool) -> Vec<usize> {
         match &self.fallback_path_terms {
             Some(terms) => terms.clone(),
@@ -429,13 +426,11 @@ impl PlanSettings {
 
     /// Whether the path optimiser holds the swept-clearance rows from the first attempt on
     /// (`swept_clearance: true`). Left unset, they are off until an attempt's plans all tunnel
-    /// through an obstacle between their samples, and on in every attempt after it: on the
-    /// generated suite (2026-12-04) that took the planar plans executable from 343 to 352 of
-    /// 360 on seeds 11–16 (whose failures it came from: a thin bar across the swing that every
-    /// attempt's path crossed between samples) and from 408 to 409 of 420 on seeds 1–7, the 3D
-    /// ones unchanged; with the replay's bisection of unconverged steps, from 342 to 350 of 360
-    /// on seeds 21–26, run only afterwards. Always on, the paper's planar case lands in a plan
-    /// whose replay departs (`docs/results.md`).
+    /// through an obstacle between their samples, and on in every attempt after it: a thin
+    /// obstacle that every attempt's path crosses between samples is then held off, while
+    /// plans that do not tunnel keep the routes the rows would make more conservative (always
+    /// on, the paper's planar case lands in a plan whose replay departs; `docs/results.md`,
+    /// docs/notes/plan-settings.md).
     pub fn swept(&self) -> bool {
         self.swept_clearance == Some(true)
     }
@@ -445,10 +440,8 @@ impl PlanSettings {
     /// case sets `equilibrium_weight`; the shipped 3D cases that do were measured with 0.1).
     /// The samples' distance to their equilibria estimates the replay's deviation to within
     /// 4e-4 L on every start measured, so a plan stopped at half the tolerance still coincides
-    /// with a margin. On the generated suite's planar problems (19 seeds, 2026-12-04, each
-    /// seed with 0.1 and 0.5 back to back) half the tolerance left every verdict as it was
-    /// (1,129 of 1,140 executable, 874 coinciding either way) and lowered the median plan time
-    /// on 18 seeds (0.084–0.174 s → 0.071–0.148 s).
+    /// with a margin, and sooner than at a tenth of it, with the same verdicts on the
+    /// generated suite (docs/notes/plan-settings.md).
     pub fn tracking_stop(&self, spatial: bool) -> f64 {
         match self.equilibrium_stop {
             Some(s) => s,
@@ -458,10 +451,9 @@ impl PlanSettings {
     }
 
     /// The equilibrium-tracking weight: `equilibrium_weight`, or by default 10,000 on a planar
-    /// rod and 0 (no tracking) on a 3D one. On the generated suite (seed 1), where the
-    /// replayed equilibria of a plan that departs can be the plan, tracking makes 49 of 60
-    /// planar plans executable against 39 without, and 3D plans without it are executable as
-    /// often or more (21 of 30 against 20) at a third of the median time (0.79 s against 2.3 s).
+    /// rod and 0 (no tracking) on a 3D one: on the generated suite tracking makes more planar
+    /// plans executable, while 3D plans are executable as often without it at a third of the
+    /// median time (docs/notes/plan-settings.md).
     pub fn tracking_weight(&self, spatial: bool) -> f64 {
         match self.equilibrium_weight {
             Some(w) => w,
@@ -556,8 +548,8 @@ fn d_rounds() -> usize {
     8
 }
 fn d_travel() -> f64 {
-    // On the generated suite (seeds 1 and 2), 0.5 made the most plans executable and coincide
-    // among 0, 0.1, 0.25, 0.5 and 1 (docs/results.md).
+    // Of 0, 0.1, 0.25, 0.5 and 1, the weight that made the most plans of the generated suite
+    // executable and coincide (docs/results.md).
     0.5
 }
 fn d_fallback_evaluations() -> usize {
@@ -565,7 +557,8 @@ fn d_fallback_evaluations() -> usize {
 }
 fn d_sharp() -> Vec<f64> {
     // Two decades in the R5 preferred-number steps (×≈1.6 per stage): a continuation this fine
-    // reaches the paper's coinciding plan from 29 of 32 starts, [10, 100, 1000] from 3 of 16.
+    // reaches the paper's coinciding plan from more starts than a coarser one
+    // (docs/notes/plan-settings.md).
     vec![
         10.0, 16.0, 25.0, 40.0, 63.0, 100.0, 160.0, 250.0, 400.0, 630.0, 1000.0,
     ]
