@@ -98,6 +98,10 @@ def test_case_fields(tmp_path):
     text["rod"]["flexural_rigidity"] = [1.0, 2.0]
     bad.write_text(json.dumps(text))
     assert field_of(lambda: dlo.Case.load(bad)) == "rod.flexural_rigidity"
+    text["rod"]["flexural_rigidity"] = 1.0
+    text["constraints"][0]["s"] = "zero"
+    bad.write_text(json.dumps(text))
+    assert field_of(lambda: dlo.Case.load(bad)) == "constraints[0].s"
     with pytest.raises(dlo.InputError) as err:
         dlo.Case.parse("{ not json")
     assert err.value.field is None

@@ -30,6 +30,21 @@ pub(crate) fn join(prefix: &str, path: &str) -> String {
     }
 }
 
+/// The value at `path` (as [`read`] gives it: `obstacles[2].shape`) inside `root`.
+pub(crate) fn at<'v>(root: &'v serde_json::Value, path: &str) -> Option<&'v serde_json::Value> {
+    let mut v = root;
+    for part in path.split('.') {
+        let (key, indices) = part.split_once('[').map_or((part, ""), |(k, i)| (k, i));
+        if !key.is_empty() {
+            v = v.get(key)?;
+        }
+        for index in indices.split('[').filter(|i| !i.is_empty()) {
+            v = v.get(index.strip_suffix(']')?.parse::<usize>().ok()?)?;
+        }
+    }
+    Some(v)
+}
+
 /// The error of a case file's `text` (at `path`) that failed at the field `field` (empty: the
 /// top level) with `e`: a value of the wrong kind, at its field (its message keeps the line and
 /// column); text that is not JSON, or JSON that is not an object, as a whole.
@@ -111,6 +126,18 @@ mod tests {
         assert_eq!(path, "items");
         let (path, _) = read::<Outer, _>(serde_json::json!("items")).unwrap_err();
         assert_eq!(path, "");
+    }
+
+    #[test]
+    fn a_path_finds_its_value() {
+        let v = serde_json::json!({"obstacles": [{}, {"shape": {"type": "ball"}}], "m": [[1, 2]]});
+        assert_eq!(
+            at(&v, "obstacles[1].shape.type"),
+            Some(&serde_json::json!("ball"))
+        );
+        assert_eq!(at(&v, "m[0][1]"), Some(&serde_json::json!(2)));
+        assert_eq!(at(&v, "obstacles[2]"), None);
+        assert_eq!(at(&v, "m[x]"), None);
     }
 
     #[test]

@@ -83,14 +83,26 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
             c(r#""rod": {"length": 1.0, "flexural_rigidity": [1.0, 2.0]}"#),
             "field `rod.flexural_rigidity`: expected a number, or `{\"start\": a, \"end\": b}`",
         ),
-        // (A constraint is tagged by its `type`, so the path ends at the entry; the line and
-        // column point into it.)
         (
             "coordinate of the wrong kind",
             c(&format!(
                 r#"{GOOD_ROD}, "constraints": [{{"type": "position", "s": 0.0, "x": "left"}}]"#
             )),
-            "field `constraints[0]`: expected a number (equality) or bounds `{\"min\": a, \"max\": b}`",
+            "field `constraints[0].x`: expected a number (equality) or bounds `{\"min\": a, \"max\": b}`",
+        ),
+        (
+            "constraint without its arc length",
+            c(&format!(
+                r#"{GOOD_ROD}, "constraints": [{{"type": "position", "x": 0.0}}]"#
+            )),
+            "field `constraints[0]`: missing field `s`",
+        ),
+        (
+            "obstacle shape field of the wrong kind",
+            c(&format!(
+                r#"{GOOD_ROD}, "obstacles": [{{"shape": {{"type": "ball", "radius": [1]}}}}]"#
+            )),
+            "field `obstacles[0].shape.radius`: invalid type: sequence, expected f64",
         ),
         (
             "negative length",
