@@ -1,6 +1,6 @@
 //! Reading a case file's JSON so that a value of the wrong kind is reported at its field
-//! (`rod.radius`, `obstacles[2].shape`, `plan.goal.position[1]`), not only at a line and
-//! column.
+//! (`rod.radius`, `obstacles[2].shape.radius`, `plan.goal.position[1]`), not only at a line and
+//! column, and the errors of a case file's text ([`file_error`]).
 
 use serde::{Deserialize, Deserializer};
 
@@ -55,6 +55,7 @@ pub(crate) fn file_error(
     e: serde_json::Error,
 ) -> crate::error::Error {
     use crate::error::Error;
+    let field = tagged_field(text, &field, &e).unwrap_or(field);
     // A case is a JSON object. Valid JSON of another kind fails as data, and serde's
     // message for an array ("expected struct CaseFile with 16 elements") names nothing
     // a user wrote.
@@ -93,6 +94,41 @@ pub(crate) fn file_error(
             message,
         }
     }
+}
+
+/// The field inside a constraint or an obstacle's shape that `e` is about, where `field` names
+/// the entry (`constraints[0]`, `obstacles[2].shape`): an entry tagged by its `type` is read
+/// whole, so serde's error names the entry only. The field is the key whose value alone, with
+/// the entry's `type`, gives the same error where the `type` alone does not (a value of the
+/// wrong kind, an unknown key); `None` where no key does (a missing field) or `field` is not
+/// such an entry.
+fn tagged_field(text: &str, field: &str, e: &serde_json::Error) -> Option<String> {
+    type Check = fn(serde_json::Value) -> Result<(), serde_json::Error>;
+    let check: Check = if field.starts_with("constraints[") && !field.contains('.') {
+        |v| serde_json::from_value::<super::ConstraintSpec>(v).map(|_| ())
+    } else if field.starts_with("obstacles[") && field.ends_with("].shape") {
+        |v| serde_json::from_value::<super::ShapeKind>(v).map(|_| ())
+    } else {
+        return None;
+    };
+    let root: serde_json::Value = serde_json::from_str(text).ok()?;
+    let entry = at(&root, field)?.as_object()?;
+    let tag = entry.get("type")?;
+    // serde_json's message without its position (errors from a value have none).
+    let message = e.to_string();
+    let message = message
+        .rsplit_once(" at line ")
+        .map_or(message.as_str(), |(m, _)| m);
+    let gives = |v: serde_json::Value| check(v).is_err_and(|e| e.to_string() == message);
+    // An error the tag alone gives (a missing field) is no key's.
+    if gives(serde_json::json!({ "type": tag })) {
+        return None;
+    }
+    entry
+        .iter()
+        .filter(|(k, _)| *k != "type")
+        .find(|(k, v)| gives(serde_json::json!({ "type": tag, *k: v })))
+        .map(|(k, _)| format!("{field}.{k}"))
 }
 
 #[cfg(test)]

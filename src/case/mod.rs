@@ -1,7 +1,7 @@
 //! Case files: JSON parsed with serde into typed values (`deny_unknown_fields`), then validated
 //! once into a [`Case`] holding a ready [`StaticProblem`]. Every field is documented in
-//! docs/case-files.md with its units and default. Lengths, forces and rigidities are in any one consistent
-//! unit system; angles in radians.
+//! docs/case-files.md with its units and default. Lengths, forces and rigidities are in any one
+//! consistent unit system; angles in radians.
 
 mod field_path;
 pub mod frame;
@@ -455,46 +455,8 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, Error> {
     let mut de = serde_json::Deserializer::from_str(text);
     let file: CaseFile = field_path::read(&mut de)
         .and_then(|file| de.end().map(|()| file).map_err(|e| (String::new(), e)))
-        .map_err(|(field, e)| {
-            let field = tagged_field(text, &field, &e).unwrap_or(field);
-            field_path::file_error(text, path, field, e)
-        })?;
+        .map_err(|(field, e)| field_path::file_error(text, path, field, e))?;
     build(file, path)
-}
-
-/// The field inside a constraint or an obstacle's shape that `e` is about, where `field` names
-/// the entry (`constraints[0]`, `obstacles[2].shape`): an entry tagged by its `type` is read
-/// whole, so serde's error names the entry only. The field is the key whose value alone, with
-/// the entry's `type`, gives the same error where the `type` alone does not (a value of the
-/// wrong kind, an unknown key); `None` where no key does (a missing field) or `field` is not
-/// such an entry.
-fn tagged_field(text: &str, field: &str, e: &serde_json::Error) -> Option<String> {
-    type Check = fn(serde_json::Value) -> Result<(), serde_json::Error>;
-    let check: Check = if field.starts_with("constraints[") && !field.contains('.') {
-        |v| serde_json::from_value::<ConstraintSpec>(v).map(|_| ())
-    } else if field.starts_with("obstacles[") && field.ends_with("].shape") {
-        |v| serde_json::from_value::<ShapeKind>(v).map(|_| ())
-    } else {
-        return None;
-    };
-    let root: serde_json::Value = serde_json::from_str(text).ok()?;
-    let entry = field_path::at(&root, field)?.as_object()?;
-    let tag = entry.get("type")?;
-    // serde_json's message without its position (errors from a value have none).
-    let message = e.to_string();
-    let message = message
-        .rsplit_once(" at line ")
-        .map_or(message.as_str(), |(m, _)| m);
-    let gives = |v: serde_json::Value| check(v).is_err_and(|e| e.to_string() == message);
-    // An error the tag alone gives (a missing field) is no key's.
-    if gives(serde_json::json!({ "type": tag })) {
-        return None;
-    }
-    entry
-        .iter()
-        .filter(|(k, _)| *k != "type")
-        .find(|(k, v)| gives(serde_json::json!({ "type": tag, *k: v })))
-        .map(|(k, _)| format!("{field}.{k}"))
 }
 
 pub(crate) struct V<'a> {
