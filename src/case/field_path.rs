@@ -19,6 +19,16 @@ where
     })
 }
 
+/// `T` read from `value`, the value of the section or field `prefix` (`grasp`, `goal`; empty:
+/// the section itself); on failure, the path of the field it failed at, `prefix` included, and
+/// serde's message.
+pub(crate) fn read_in<T: serde::de::DeserializeOwned>(
+    prefix: &str,
+    value: serde_json::Value,
+) -> Result<T, (String, String)> {
+    read(value).map_err(|(field, e)| (join(prefix, &field), e.to_string()))
+}
+
 /// The field `path` inside the section `prefix` (`plan` and `goal.x` give `plan.goal.x`);
 /// either may be empty.
 pub(crate) fn join(prefix: &str, path: &str) -> String {

@@ -17,8 +17,8 @@ impl Grasp {
                 "missing: `dlo margin` needs a `grasp` section".into(),
             ));
         };
-        let settings: GraspSettings = super::field_path::read(raw.clone())
-            .map_err(|(field, e)| err(super::field_path::join("grasp", &field), e.to_string()))?;
+        let settings: GraspSettings = super::field_path::read_in("grasp", raw.clone())
+            .map_err(|(field, message)| err(field, message))?;
         let problem = GraspProblem {
             statics: case.builder.clone(),
             initial: case.initial.clone(),

@@ -297,7 +297,7 @@ pub fn plan_section(case: &Case) -> Result<(End, End, PlanSettings), Error> {
 /// The section's `start` and `goal`, and its other keys as settings; an error names the field
 /// inside the section it is at (empty: the section itself).
 fn split(raw: serde_json::Value) -> Result<(EndSpec, EndSpec, PlanSettings), (String, String)> {
-    use super::field_path::{join, read};
+    use super::field_path::read_in;
     let serde_json::Value::Object(mut map) = raw else {
         return Err((String::new(), "must be an object".into()));
     };
@@ -305,12 +305,11 @@ fn split(raw: serde_json::Value) -> Result<(EndSpec, EndSpec, PlanSettings), (St
         let value = map
             .remove(key)
             .ok_or_else(|| (String::new(), format!("missing field `{key}`")))?;
-        read(value).map_err(|(field, e)| (join(key, &field), e.to_string()))
+        read_in(key, value)
     };
     let start = take("start")?;
     let goal = take("goal")?;
-    let settings =
-        read(serde_json::Value::Object(map)).map_err(|(field, e)| (field, e.to_string()))?;
+    let settings = read_in("", serde_json::Value::Object(map))?;
     Ok((start, goal, settings))
 }
 
