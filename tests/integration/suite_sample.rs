@@ -358,16 +358,14 @@ fn suite_3d_plan(
     suite_3d_plan_observed(
         i,
         serde_json::json!({}),
-        serde_json::json!({}),
         &mut dlo_planner::planner::observer::Silent,
     )
 }
 
-/// [`suite_3d_plan`], telling `observer` of the run, with `plan` (a JSON object) merged into
-/// the case's `plan` section and `fields` into the case ([`merge`], as `plan_suite --case`).
+/// [`suite_3d_plan`], telling `observer` of the run, with `fields` merged into the case
+/// ([`merge`], as `plan_suite --case`: `{"plan": {…}}` for plan settings).
 fn suite_3d_plan_observed(
     i: usize,
-    plan: serde_json::Value,
     fields: serde_json::Value,
     observer: &mut dyn dlo_planner::planner::observer::PlanObserver,
 ) -> (
@@ -378,9 +376,6 @@ fn suite_3d_plan_observed(
     use dlo_planner::planner::Planner;
     let text = spatial_text(1, 68, i);
     let mut case: serde_json::Value = serde_json::from_str(&text).expect("JSON");
-    for (k, v) in plan.as_object().expect("an object") {
-        case["plan"][k] = v.clone();
-    }
     merge(&mut case, &fields);
     let path = format!("planning_cases/spatial_{i}.json");
     let c = case::parse(&case.to_string(), std::path::Path::new(&path)).expect("a generated case");
@@ -477,8 +472,8 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
         }
     }
     let mut logged = Optimal(Vec::new());
-    let always_optimise = serde_json::json!({ "straight_path_first": false });
-    let (p, r) = suite_3d_plan_observed(12, always_optimise, serde_json::json!({}), &mut logged);
+    let always_optimise = serde_json::json!({ "plan": { "straight_path_first": false } });
+    let (p, r) = suite_3d_plan_observed(12, always_optimise, &mut logged);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
     assert!(e.executable && e.reason.is_none(), "{e:?}");
@@ -522,7 +517,7 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
 fn a_heavy_cables_straight_trajectory_is_the_plan_where_its_equilibria_attain_the_bound() {
     use dlo_planner::planner::observer::Silent;
     let heavy = serde_json::json!({"rod": {"weight_per_length": 10.0}});
-    let (p, r) = suite_3d_plan_observed(5, serde_json::json!({}), heavy, &mut Silent);
+    let (p, r) = suite_3d_plan_observed(5, heavy, &mut Silent);
     assert!(
         r.optimiser.is_none() && r.starts.is_empty(),
         "the optimiser ran"
