@@ -275,6 +275,9 @@ pub struct Outcome {
     pub by_equilibria: bool,
     /// Of those, along the straight-line path's trajectory (no optimised path executable).
     pub by_straight: bool,
+    /// The plan ends on another equilibrium of the goal pose than its static solve's, which
+    /// the gripper's motion reached (`PlanResult::reached_goal`).
+    pub reached_goal: bool,
     /// Why not executable: the verdict, and why the replayed equilibria are not a plan.
     pub why_not: Option<String>,
     pub snaps: bool,
@@ -298,7 +301,7 @@ pub struct Outcome {
 /// grid's; units of L), and where in k.
 fn independent_clearance(p: &Planner, r: &PlanResult) -> (f64, f64) {
     let model = fine_model(&p.base.model, 4 * p.verify_s_intervals(), 2);
-    let path = p.with_terms(r.path_terms).path();
+    let path = p.path_of(r);
     let n = 2 * (p.settings.verify_k_samples - 1);
     let mut a = vec![0.0; path.n()];
     let mut shape = Shape::default();
@@ -477,6 +480,7 @@ pub fn run(
         executable: executed.is_some(),
         by_equilibria: executed == Some("equilibria"),
         by_straight: executed.is_some() && along_straight,
+        reached_goal: r.reached_goal.is_some(),
         why_not: executed.is_none().then(|| {
             format!(
                 "{}{}",
@@ -538,6 +542,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let executable = out.iter().filter(|o| o.executable).count();
     let by_equilibria = out.iter().filter(|o| o.by_equilibria).count();
     let by_straight = out.iter().filter(|o| o.by_straight).count();
+    let reached = out.iter().filter(|o| o.reached_goal).count();
     let snaps = out.iter().filter(|o| o.snaps).count();
     let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
     let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
@@ -547,7 +552,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
-        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path; {reached} to a reached goal) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
         pct(planned),
         pct(coincide),
         pct(executable),
@@ -715,6 +720,12 @@ fn main() {
                             o.replay.2,
                             o.attempts
                         );
+                        if o.reached_goal {
+                            eprintln!(
+                                "{:16} planned to the equilibrium of the goal pose its first plan's motion reached",
+                                o.name
+                            );
+                        }
                         if let Some(why) = &o.why_not {
                             eprintln!("{:16} not executable: {why}", o.name);
                         }

@@ -80,6 +80,11 @@ pub struct EquilibriumPlan {
     /// The shapes dip into an obstacle between the solves' contact points.
     #[serde(skip)]
     pub(crate) dips: bool,
+    /// Where the replay converges, stays stable and never snaps but ends on another
+    /// equilibrium of the goal pose than the goal shape, its shapes clear of the obstacles:
+    /// that equilibrium's coefficients (the replay's last shape).
+    #[serde(skip)]
+    pub(crate) reached_goal: Option<Vec<f64>>,
 }
 
 impl EquilibriumPlan {
@@ -149,6 +154,12 @@ pub fn k_list(ks: &[f64]) -> String {
 /// What keeps a replay's shapes from being a plan, if anything: the first failing check of
 /// [`EquilibriumPlan::executable`] other than the confirmation.
 fn failure(first: &Replay) -> Option<String> {
+    failure_on_the_way(first).or_else(|| ends_elsewhere(first))
+}
+
+/// The checks of [`failure`] before the goal: every solve converged, nothing snaps, every shape
+/// is stable.
+fn failure_on_the_way(first: &Replay) -> Option<String> {
     let ks = |f: &dyn Fn(&super::replay::ReplayStep) -> bool| -> Vec<f64> {
         first.steps.iter().filter(|s| f(s)).map(|s| s.k).collect()
     };
@@ -173,13 +184,18 @@ fn failure(first: &Replay) -> Option<String> {
             k_list(&ks(&|s| s.stable == Some(false)))
         ));
     }
-    if first.end_deviation_over_l > first.tolerance {
-        return Some(format!(
+    None
+}
+
+/// Where the replay's last shape is not the goal shape: why (the goal pose holds another
+/// equilibrium there).
+fn ends_elsewhere(first: &Replay) -> Option<String> {
+    (first.end_deviation_over_l > first.tolerance).then(|| {
+        format!(
             "the replay ends {:.3e} L from the goal shape: the goal pose holds another equilibrium there",
             first.end_deviation_over_l
-        ));
-    }
-    None
+        )
+    })
 }
 
 /// Whether the shapes of `replay` keep clear of every obstacle and of themselves on the
@@ -266,12 +282,29 @@ impl Planner {
             trajectory: "optimal_path",
             optimal_path_not_executable: None,
             dips: false,
+            reached_goal: None,
         };
         if plan.reason.is_none() {
             let (why, clearance, dips) = penetration(self, fine, first);
             plan.reason = why;
             plan.min_clearance = clearance;
             plan.dips = dips;
+        } else if failure_on_the_way(first).is_none() {
+            // It ends on another equilibrium of the goal pose: where its shapes keep clear, the
+            // gripper's motion reaches it (a plan to it is judged on its own,
+            // [`super::reached_goal`]); where they dip between the solves' contact points, it
+            // may be their artefact, and the shapes are replayed again as any that dip are.
+            let (why, clearance, dips) = penetration(self, fine, first);
+            if why.is_none() {
+                plan.reached_goal = first
+                    .steps
+                    .last()
+                    .filter(|s| s.k == 1.0)
+                    .map(|s| s.a.clone());
+            } else if dips {
+                plan.min_clearance = clearance;
+                plan.dips = true;
+            }
         }
         if plan.reason.is_some() || self.stopped() {
             plan.reason.get_or_insert_with(|| "interrupted".into());

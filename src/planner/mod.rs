@@ -12,6 +12,7 @@ pub mod minimax;
 pub mod observer;
 pub mod orientation;
 pub mod path;
+mod reached_goal;
 pub mod replay;
 pub mod result;
 pub mod settings;
@@ -35,7 +36,7 @@ use crate::statics::{SolveStatus, StaticOptions, StaticSettings, StaticSolution,
 pub use endpoints::End;
 use endpoints::EndPose;
 use minimax::MinimaxProblem;
-use observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
+use observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord};
 use replay::{EarlyStop, Replay, ReplayOptions, replay};
 pub use settings::{Optimiser, PlanSettings, Workspace};
 use std::sync::Arc;
@@ -44,7 +45,7 @@ use verify::fine_model;
 
 pub use result::{
     Attempt, ContactRefinement, ContactTry, EndInside, PlanReport, PlanResult, PlanStatus,
-    PlanVerdict, StartSummary, Timing, VerificationGrid,
+    PlanVerdict, ReachedGoal, StartSummary, Timing, VerificationGrid,
 };
 use start::Verified;
 use starts::StartPlan;
@@ -203,6 +204,9 @@ pub struct Planner {
     timed_out: Arc<AtomicBool>,
     /// The quick first attempt of a planar rod ([`Attempt::Quick`]).
     quick: bool,
+    /// The goal was given by its pose alone (no `shape`), and no plan has yet been made again
+    /// to an equilibrium of it the gripper's motion reaches ([`PlanSettings::reached_goal`]).
+    goal_by_pose: bool,
     /// Judgements replay equilibria that still dip on [`Planner::finer_contacts`]: set on the
     /// copy that judges the search's plans again where none was executable.
     finer_retry: bool,
@@ -348,7 +352,16 @@ fn end_shape(
             (None, None) => problem.initial.clone(),
         };
         let sol = solve_from(pose.problem(base), &a0, opts);
-        let first = on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance);
+        let first = on_chords_if_dipping(
+            base,
+            &problem.obstacles,
+            &pose,
+            sol,
+            fine,
+            opts,
+            coincide_tolerance,
+            false,
+        );
         let converged = first.0.status == SolveStatus::Converged;
         if end.shape.is_some() || (converged && !least_energy) {
             first
@@ -375,7 +388,16 @@ fn end_shape(
             .into_iter()
             .map(|a| {
                 let sol = solve_from(pose.problem(base), &a, opts);
-                on_chords_if_dipping(problem, &pose, sol, fine, opts, coincide_tolerance)
+                on_chords_if_dipping(
+                    base,
+                    &problem.obstacles,
+                    &pose,
+                    sol,
+                    fine,
+                    opts,
+                    coincide_tolerance,
+                    false,
+                )
             });
             let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
             let best = retried
@@ -469,27 +491,39 @@ fn solve_from(mut p: StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticS
 /// chords held off the obstacles by [`hold_off_margin`] (of the plan's `coincide_tolerance`),
 /// when that converges clear. An end resting on an obstacle is a legal end of a path only when
 /// the end grid finds it clear. Returned with how its contacts are held: `None` at the
-/// sample points, `Some(margin)` on the chords, `margin` (units of L) off the obstacles.
+/// sample points, `Some(margin)` on the chords, `margin` (units of L) off the obstacles. With
+/// `warm`, each solve starts from the multipliers its starting shape needs (least squares), so
+/// that it stays on that shape's equilibrium; else from zero.
+#[allow(clippy::too_many_arguments)]
 fn on_chords_if_dipping(
-    problem: &PlanProblem,
+    statics: &StaticProblem,
+    obstacles: &[Arc<Obstacle>],
     pose: &EndPose,
     sol: StaticSolution,
     fine: &crate::rod::model::Model,
     opts: &StaticOptions,
     coincide_tolerance: f64,
+    warm: bool,
 ) -> (StaticSolution, Option<f64>) {
-    let tol = COLLISION_TOLERANCE * problem.statics.model.rod.length;
+    let solve = |p: &mut StaticProblem, a: &[f64]| {
+        if warm {
+            let lambda = crate::statics::evaluate_shape(p, a).lambda;
+            crate::statics::solve_static_warm(p, a, &lambda, opts)
+        } else {
+            solve_static(p, a, opts)
+        }
+    };
+    let tol = COLLISION_TOLERANCE * statics.model.rod.length;
     let depth = |a: &[f64]| {
-        verify::shape_worst_clearance(fine, &problem.obstacles, a)
-            .map_or(f64::INFINITY, |w| w.clearance)
+        verify::shape_worst_clearance(fine, obstacles, a).map_or(f64::INFINITY, |w| w.clearance)
     };
     if sol.status != SolveStatus::Converged || depth(&sol.a) >= -tol {
         return (sol, None);
     }
-    let Some(chords) = equilibrium_plan::on_chords(&problem.statics) else {
+    let Some(chords) = equilibrium_plan::on_chords(statics) else {
         return (sol, None);
     };
-    let again = solve_static(&mut pose.problem(&chords), &sol.a, opts);
+    let again = solve(&mut pose.problem(&chords), &sol.a);
     if again.status != SolveStatus::Converged {
         return (sol, None);
     }
@@ -499,12 +533,12 @@ fn on_chords_if_dipping(
     }
     // Still inside (the rod bulges into the obstacle between the points): held off it by
     // twice that depth, as the replayed equilibria are ([`Planner::judge_path`]).
-    let length = problem.statics.model.rod.length;
+    let length = statics.model.rod.length;
     let Some(margin) = hold_off_margin(-d, length, coincide_tolerance) else {
         return (sol, None);
     };
-    let held = equilibrium_plan::held_off(&problem.statics, margin);
-    let off = solve_static(&mut pose.problem(&held), &again.a, opts);
+    let held = equilibrium_plan::held_off(statics, margin);
+    let off = solve(&mut pose.problem(&held), &again.a);
     if off.status == SolveStatus::Converged && depth(&off.a) >= -tol {
         (off, Some(margin))
     } else {
@@ -816,6 +850,9 @@ impl Planner {
                 if let Some(why) = &plan.reason {
                     ep.retry_failed(what, why);
                 }
+                if ep.reached_goal.is_none() {
+                    ep.reached_goal = plan.reached_goal;
+                }
                 match plan.min_clearance {
                     Some(c) if plan.dips => -c,
                     _ => 0.0,
@@ -1015,6 +1052,7 @@ impl Planner {
             deadline: None,
             timed_out: Arc::new(AtomicBool::new(false)),
             quick: false,
+            goal_by_pose: problem.goal.is_pose() && problem.goal.shape.is_none(),
             finer_retry: false,
             workers: workers::Workers::new(settings.threads()),
             end_grid: Arc::new((verify_s, fine)),
@@ -1349,8 +1387,14 @@ impl Planner {
 
     /// [`Planner::run`] on this planner's deadline.
     fn run_searched(&self, observer: &mut dyn PlanObserver) -> PlanResult {
+        observer.begin(&self.base.model);
+        let (result, shapes) = self.search(observer);
+        self.towards_reached_goal(result, shapes, observer)
+    }
+
+    /// The search of [`Planner::run`]: the plan, and its replay's shapes, not yet logged.
+    fn search(&self, observer: &mut dyn PlanObserver) -> (PlanResult, RecordedShapes) {
         let model = &self.base.model;
-        observer.begin(model);
         observer.phase("endpoints");
         for (k, sol) in [(0.0, &self.start), (1.0, &self.goal)] {
             let sh = model.evaluate(&sol.a);
@@ -1475,11 +1519,15 @@ impl Planner {
                 }
                 judged = s;
                 along_straight = true;
-            } else if let (Some(e), Some(why)) = (
-                judged.equilibrium_plan.as_mut(),
-                s.equilibrium_plan.and_then(|e| e.reason),
-            ) {
-                e.retry_failed("along the straight path's trajectory", &why);
+            } else if let (Some(e), Some(s)) =
+                (judged.equilibrium_plan.as_mut(), s.equilibrium_plan)
+            {
+                if let Some(why) = &s.reason {
+                    e.retry_failed("along the straight path's trajectory", why);
+                }
+                if e.reached_goal.is_none() {
+                    e.reached_goal = s.reached_goal;
+                }
             }
         }
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
@@ -1496,7 +1544,6 @@ impl Planner {
                 (a.clone(), e, c)
             });
         }
-        flush(&judged.shapes, model, observer);
         let interrupted = self.poll(observer) || self.stopped();
         let t_replay = judged.seconds;
         let (rep, equilibrium_plan, judged_workspace) =
@@ -1523,7 +1570,7 @@ impl Planner {
         } else {
             PlanStatus::Planned
         };
-        PlanResult {
+        let result = PlanResult {
             status,
             optimiser,
             straight_path_plan: best.is_none() && end_inside.is_none(),
@@ -1577,7 +1624,9 @@ impl Planner {
                 plan: t_plan,
                 replay: t_replay,
             },
-        }
+            reached_goal: None,
+        };
+        (result, judged.shapes)
     }
 }
 

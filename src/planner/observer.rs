@@ -71,7 +71,10 @@ pub trait PlanObserver {
     /// Called once before anything else with the model every shape refers to.
     fn begin(&mut self, _model: &Model) {}
     /// A phase starts: `"endpoints"`, `"optimise"` (every start optimises, verifies and refines
-    /// its plan), `"select"` (the start with the best verified plan is chosen), `"replay"`.
+    /// its plan), `"select"` (the start with the best verified plan is chosen), `"replay"`;
+    /// then, where a goal given by its pose alone is planned again to the equilibrium the
+    /// gripper's motion reached ([`super::PlanSettings::reached_goal`]), `"reached goal"` and
+    /// the same phases again.
     fn phase(&mut self, _name: &str) {}
     /// A shape was computed.
     fn shape(&mut self, _model: &Model, _record: &ShapeRecord) {}
@@ -118,6 +121,8 @@ struct Recorded {
 pub(crate) struct Recorder<'a> {
     inner: &'a mut dyn PlanObserver,
     shapes: Vec<Recorded>,
+    /// Phases and the optimiser's progress are passed on to `inner` as they come.
+    passing: bool,
 }
 
 impl<'a> Recorder<'a> {
@@ -126,6 +131,16 @@ impl<'a> Recorder<'a> {
         Recorder {
             inner,
             shapes: Vec::new(),
+            passing: false,
+        }
+    }
+
+    /// A recorder that also passes on phases and the optimiser's progress to `inner` (a
+    /// search whose shapes are logged only if its plan is chosen).
+    pub(crate) fn passing(inner: &'a mut dyn PlanObserver) -> Self {
+        Recorder {
+            passing: true,
+            ..Recorder::new(inner)
         }
     }
 
@@ -185,6 +200,18 @@ impl PlanObserver for Recorder<'_> {
             reactions: r.reactions.to_vec(),
             violation: r.violation,
         });
+    }
+
+    fn phase(&mut self, name: &str) {
+        if self.passing {
+            self.inner.phase(name);
+        }
+    }
+
+    fn progress(&mut self, model: &Model, p: &Progress, worst: &[f64]) {
+        if self.passing {
+            self.inner.progress(model, p, worst);
+        }
     }
 
     fn stop_requested(&mut self) -> bool {

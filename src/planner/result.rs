@@ -242,7 +242,7 @@ pub struct PlanResult {
     pub chosen_start: Option<usize>,
     /// Path vectors `cᵢ` (coefficient space).
     pub path: Vec<Vec<f64>>,
-    /// The unknowns `z` of the plan's path, `planner.with_terms(path_terms).path()`.
+    /// The unknowns `z` of the plan's path ([`super::Planner::path_of`]).
     #[serde(skip)]
     pub z: Vec<f64>,
     /// Feasibility replay.
@@ -260,6 +260,32 @@ pub struct PlanResult {
     pub added_samples: Vec<f64>,
     /// Seconds spent planning (optimise + verify) and replaying.
     pub timing_s: Timing,
+    /// Where the plan ends on another equilibrium of the goal pose than the one its static
+    /// solve found ([`super::PlanSettings::reached_goal`]): that solve's shape and the one
+    /// the plan ends on. Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reached_goal: Option<ReachedGoal>,
+}
+
+/// The goal shape a plan ends on where it is not the one the goal pose's static solve found
+/// ([`PlanResult::reached_goal`]): no plan to that one was executable, and the gripper's
+/// motion along the best plan's trajectory brought the rod to this equilibrium of the same
+/// pose (stable, clear of the obstacles), so the plan was made again to it.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReachedGoal {
+    /// Internal energy of the goal shape the static solve found (case units).
+    pub solved_energy: f64,
+    /// Internal energy of the goal shape the plan ends on (case units).
+    pub energy: f64,
+    /// Largest distance between the two shapes (fraction of L).
+    pub distance_over_l: f64,
+    /// Ritz coefficients of the goal shape the plan ends on (the plan's path runs from the
+    /// start shape to it: [`super::Planner::path_of`]).
+    pub shape: Vec<f64>,
+    /// Why the first plan was not executable: its verdict and what its equilibria met.
+    pub first_plan: String,
+    /// Seconds the first plan's search took (in [`PlanResult::timing_s`] too).
+    pub first_plan_seconds: f64,
 }
 
 impl PlanResult {
@@ -386,7 +412,8 @@ pub struct PlanReport<'a> {
     pub verification_grid: VerificationGrid,
     /// Internal energy of the start shape (case units).
     pub start_energy: f64,
-    /// Internal energy of the goal shape (case units).
+    /// Internal energy of the goal shape (case units): the one the plan ends on
+    /// ([`PlanResult::reached_goal`]).
     pub goal_energy: f64,
     /// The MCAP log written.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -422,7 +449,10 @@ impl<'a> PlanReport<'a> {
                 s_intervals: planner.verify_s_intervals(),
             },
             start_energy: planner.start.energy.internal(),
-            goal_energy: planner.goal.energy.internal(),
+            goal_energy: result
+                .reached_goal
+                .as_ref()
+                .map_or(planner.goal.energy.internal(), |g| g.energy),
             mcap: None,
             log_shapes: None,
             trajectory_csv: None,

@@ -113,6 +113,13 @@ pub struct PlanSettings {
     /// the stable shape with the least energy of all that converge; `false` (default): the
     /// first solve's shape, where it converges.
     pub least_energy_ends: bool,
+    /// A goal given by its pose alone (no `shape`): where no plan to the goal shape its static
+    /// solve found is executable, but the gripper's motion along the best plan's trajectory
+    /// brings the rod to another equilibrium of the goal pose — every solve of its replay
+    /// converged, stable, clear of the obstacles, nothing snapping — plan again to that
+    /// equilibrium, and report the plan to it where it is executable
+    /// ([`super::PlanResult::reached_goal`]); `false`: only the end solve's goal shape.
+    pub reached_goal: bool,
     /// Lift a converged plan that is collision-free but not executable — the quick attempt's
     /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the
     /// first fallback count's path terms and run equilibrium tracking on it again
@@ -194,6 +201,7 @@ impl Default for PlanSettings {
             straight_path_first: true,
             quick_attempt: true,
             least_energy_ends: false,
+            reached_goal: true,
             lift: true,
             time_limit: None,
         }

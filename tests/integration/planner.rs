@@ -962,7 +962,7 @@ fn plan_keeps_the_rod_from_crossing_itself() {
     let r = p.run(&mut Silent);
     assert_eq!(r.status, PlanStatus::Planned);
     // The plan's own path (a fallback's when one was chosen).
-    let planned = gap(&p.with_terms(r.path_terms).path(), &r.z);
+    let planned = gap(&p.path_of(&r), &r.z);
     assert!(planned >= 0.0, "plan: gap {planned}");
     assert_eq!(
         r.verification.self_contact.map(|(g, _)| g >= 0.0),

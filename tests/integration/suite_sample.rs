@@ -132,7 +132,7 @@ fn on_a_finer_grid(
 ) -> dlo_planner::planner::verify::Verification {
     use dlo_planner::planner::verify::{fine_model, verify_with};
     let fine = fine_model(&p.base.model, 1024, 4);
-    let path = p.with_terms(r.path_terms).path();
+    let path = p.path_of(r);
     verify_with(
         &fine,
         &path,
@@ -402,6 +402,25 @@ fn equilibria_that_dip_between_contact_points_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's planar problem `planar_9_56` (seed 9), planned with the defaults: the replay of
+/// its best plan, its contacts held at the sample points, converges, stays stable and never
+/// snaps, but ends 0.023 L from the goal shape, on another equilibrium of the goal pose, and
+/// its shapes dip into a box between the contact points. That equilibrium is the dip's
+/// artefact: replayed on the chords between the points, as shapes that dip are, the
+/// equilibria end on the goal shape and are the executable plan, checked as above.
+#[test]
+fn equilibria_that_dip_and_end_elsewhere_are_replayed_on_chords() {
+    let (p, r) = suite_planar_plan_of(9, 56);
+    assert!(!r.replay.coincide, "the optimal path's replay coincides");
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    let e = r.equilibrium_plan.as_ref().expect("checked");
+    assert!(e.executable && e.reason.is_none(), "{e:?}");
+    assert_eq!(e.contact, "chords");
+    assert!(r.reached_goal.is_none());
+    assert!(r.replay.end_deviation_over_l <= r.replay.tolerance);
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
 /// The equilibria `e` of `p`'s plan are executable on the chords between contact points, held
 /// off the obstacles by a margin within a twentieth of the coincidence tolerance; the margin
 /// (case units).
@@ -493,7 +512,7 @@ fn the_straight_paths_trajectory_is_the_plan_when_no_optimised_path_executes() {
         }
     }
     // The log's optimal path is the optimiser's, at every replay step.
-    let best = p.with_terms(r.path_terms).path();
+    let best = p.path_of(&r);
     let mut a_best = vec![0.0; best.n()];
     assert_eq!(logged.0.len(), r.replay.steps.len());
     for (k, a) in &logged.0 {
@@ -1440,4 +1459,101 @@ fn the_report_gives_a_thin_rods_finer_verification_grid() {
         );
         assert!(r.verdict().is_executable(), "{radius:?}: {}", r.verdict());
     }
+}
+
+/// The suite's 3D problem `spatial_4_26` (seed 4) with a heavy cable, weight 10 per length
+/// (`plan_suite --seed 4 --only 3d --case '{"rod": {"weight_per_length": 10}}'`). Its goal is
+/// a pose alone. No plan to the goal shape its static solve found is executable: the gripper's
+/// motion along the best one's trajectory brings the cable to another equilibrium of the goal
+/// pose. Planned again to that equilibrium, the plan is executable. Checked independently:
+/// the new goal shape holds the goal shape's end pose (the gripper's) to 1e-9 L and 1e-9 rad,
+/// a static solve there from it stays on it (to 1e-6 L) and finds it stable, it lies beyond
+/// the coincidence tolerance from the solved goal shape, its energy is its own, the plan's
+/// path ends on it and its replay ends within the tolerance of it. With `reached_goal` off,
+/// the same problem has no executable plan, and the reason names the other equilibrium.
+#[test]
+fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
+    use dlo_planner::planner::Planner;
+    use dlo_planner::planner::endpoints::EndPose;
+    use dlo_planner::planner::observer::Silent;
+    use dlo_planner::statics::{SolveStatus, solve_static};
+    let plan = |fields: serde_json::Value| {
+        let mut v: serde_json::Value =
+            serde_json::from_str(&spatial_text(4, 65, 26)).expect("JSON");
+        merge(
+            &mut v,
+            &serde_json::json!({"rod": {"weight_per_length": 10}}),
+        );
+        merge(&mut v, &fields);
+        let path = std::path::Path::new("planning_cases/spatial_4_26.json");
+        let c = dlo_planner::case::parse(&v.to_string(), path).expect("a generated case");
+        let p = Planner::from_case(&c).expect("start and goal solve");
+        let r = p.run(&mut Silent);
+        (p, r)
+    };
+    let (p, r) = plan(serde_json::json!({}));
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    let g = r
+        .reached_goal
+        .as_ref()
+        .expect("planned to the reached goal");
+    assert!(
+        g.first_plan.contains("another equilibrium"),
+        "{}",
+        g.first_plan
+    );
+    let model = &p.base.model;
+    let (solved, reached) = (model.evaluate(&p.goal.a), model.evaluate(&g.shape));
+    let tip = model.boundary(1.0);
+    for i in 0..3 {
+        assert!((solved.positions[tip][i] - reached.positions[tip][i]).abs() < 1e-9);
+    }
+    let (a0, a1) = (
+        model.angles_at(&p.goal.a, 1.0),
+        model.angles_at(&g.shape, 1.0),
+    );
+    for i in 0..3 {
+        assert!((a0[i] - a1[i]).abs() < 1e-9, "{a0:?} {a1:?}");
+    }
+    let mut held = EndPose::of(model, &p.goal.a, &solved.positions).problem(&p.base);
+    let again = solve_static(&mut held, &g.shape, &p.static_options);
+    assert_eq!(again.status, SolveStatus::Converged);
+    assert_eq!(again.stable, Some(true));
+    let farthest = |x: &[[f64; 3]], y: &[[f64; 3]]| {
+        x.iter()
+            .zip(y)
+            .map(|(u, v)| (0..3).map(|i| (u[i] - v[i]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max)
+    };
+    let moved = farthest(&model.evaluate(&again.a).positions, &reached.positions);
+    assert!(moved < 1e-6, "{moved}");
+    let apart = farthest(&solved.positions, &reached.positions);
+    assert!(apart > p.settings.coincide_tolerance, "{apart}");
+    assert!((apart - g.distance_over_l).abs() < 1e-12);
+    let unit = model.rod.energy_unit();
+    let energy = model
+        .energy(&g.shape, &reached, p.base.objective, None)
+        .scaled(unit)
+        .internal();
+    assert!(
+        (energy - g.energy).abs() <= 1e-9 * energy.abs(),
+        "{energy} {}",
+        g.energy
+    );
+    assert_eq!(g.solved_energy, p.goal.energy.internal());
+    let path = p.path_of(&r);
+    let mut end = vec![0.0; path.n()];
+    path.shape_at(&r.z, 1.0, &mut end);
+    assert_eq!(end, g.shape);
+    assert!(r.replay.end_deviation_over_l <= r.replay.tolerance);
+    // Without it: not executable, for that reason.
+    let (_, off) = plan(serde_json::json!({"plan": {"reached_goal": false}}));
+    assert!(!off.verdict().is_executable());
+    assert!(off.reached_goal.is_none());
+    let why = off.equilibrium_plan.as_ref().and_then(|e| e.reason.clone());
+    assert!(
+        why.as_deref()
+            .is_some_and(|w| w.contains("another equilibrium")),
+        "{why:?}"
+    );
 }

@@ -385,7 +385,7 @@ fn a_plan_in_a_frame_reaches_the_written_poses() {
         }
     }
     let model = &p.base.model;
-    let path = p.with_terms(r.path_terms).path();
+    let path = p.path_of(&r);
     let mut a = vec![0.0; path.n()];
     for pose in &t.poses {
         path.shape_at(&r.z, pose.k, &mut a);

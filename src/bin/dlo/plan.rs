@@ -486,6 +486,13 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             .map_or("n/a".into(), |c| format!("{c:.4e}")),
         p.violation
     );
+    if let Some(g) = &p.reached_goal {
+        let _ = writeln!(
+            o,
+            "  goal shape: the equilibrium of the goal pose the gripper's motion reached (energy {:.6e}), {:.3e} L from the one its static solve found (energy {:.6e}); the plan to that one: {}",
+            g.energy, g.distance_over_l, g.solved_energy, g.first_plan
+        );
+    }
     if let Some(c) = &p.contact_samples {
         let _ = writeln!(
             o,
