@@ -1388,8 +1388,8 @@ impl Planner {
     /// [`Planner::run`] on this planner's deadline.
     fn run_searched(&self, observer: &mut dyn PlanObserver) -> PlanResult {
         observer.begin(&self.base.model);
-        let (result, shapes) = self.search(observer);
-        self.towards_reached_goal(result, shapes, observer)
+        let (result, replayed) = self.search(observer);
+        self.towards_reached_goal(result, replayed, observer)
     }
 
     /// The search of [`Planner::run`]: the plan, and its replay's shapes, not yet logged.

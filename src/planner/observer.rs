@@ -155,6 +155,17 @@ impl<'a> Recorder<'a> {
 pub(crate) struct RecordedShapes(Vec<Recorded>);
 
 impl RecordedShapes {
+    /// The goal shape among them (the end shape at `k = 1`), if any.
+    pub(crate) fn goal_shape(&self) -> RecordedShapes {
+        RecordedShapes(
+            self.0
+                .iter()
+                .filter(|r| r.kind == PathKind::Endpoint && r.k == 1.0)
+                .cloned()
+                .collect(),
+        )
+    }
+
     /// Gives every optimal-path shape the coefficients, energy and clearance `f(k)` returns
     /// (a replay of another path records that path's shapes as its optimal ones).
     pub(crate) fn set_optimal(

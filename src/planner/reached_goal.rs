@@ -34,36 +34,38 @@ impl Planner {
         p.path()
     }
 
-    /// `result` (its replay's `shapes` logged with it), or, where it is not executable and
-    /// the gripper's motion along its trajectory reached another equilibrium of a goal given
-    /// by its pose alone, the plan to that equilibrium where that one is executable.
+    /// `result`, or, where it is not executable and the gripper's motion along its trajectory
+    /// reached another equilibrium of a goal given by its pose alone, the plan to that
+    /// equilibrium where that one is executable; with the reported plan's replayed shapes
+    /// (`replayed`, or the second search's) passed on to `observer`. The second search's other
+    /// shapes are not passed on but for its goal shape, at `k = 1` after the first's: the
+    /// first search's end shapes and straight path were passed on as they came, and a log
+    /// holds one of each along `k` (its optimiser's progress is passed on as it comes).
     pub(super) fn towards_reached_goal(
         &self,
         mut result: PlanResult,
-        shapes: RecordedShapes,
+        replayed: RecordedShapes,
         observer: &mut dyn PlanObserver,
     ) -> PlanResult {
         let model = &self.base.model;
         let Some((planner, mut reached)) = self.reached_goal_planner(&result) else {
-            flush(&shapes, model, observer);
+            flush(&replayed, model, observer);
             return result;
         };
-        // Its shapes are logged only if its plan is the one reported.
         let mut recorder = Recorder::passing(observer);
         recorder.phase("reached goal");
-        let (mut again, again_shapes) = planner.search(&mut recorder);
+        let (mut again, again_replayed) = planner.search(&mut recorder);
         let searched = recorder.into_shapes();
-        let first_seconds = result.timing_s.plan + result.timing_s.replay;
         if again.verdict().is_executable() {
-            flush(&searched, model, observer);
-            flush(&again_shapes, model, observer);
-            reached.first_plan_seconds = first_seconds;
+            flush(&searched.goal_shape(), model, observer);
+            flush(&again_replayed, model, observer);
+            reached.first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
             again.timing_s.plan += result.timing_s.plan;
             again.timing_s.replay += result.timing_s.replay;
             again.reached_goal = Some(reached);
             return again;
         }
-        flush(&shapes, model, observer);
+        flush(&replayed, model, observer);
         // A run stopped during the second search is a stopped run.
         if again.status == PlanStatus::Interrupted {
             result.status = PlanStatus::Interrupted;

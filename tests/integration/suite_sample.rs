@@ -1470,14 +1470,28 @@ fn the_report_gives_a_thin_rods_finer_verification_grid() {
 /// a static solve there from it stays on it (to 1e-6 L) and finds it stable, it lies beyond
 /// the coincidence tolerance from the solved goal shape, its energy is its own, the plan's
 /// path ends on it and its replay ends within the tolerance of it. With `reached_goal` off,
-/// the same problem has no executable plan, and the reason names the other equilibrium.
+/// the same problem has no executable plan, and the reason names the other equilibrium. The
+/// observer (a log) is told of the end shapes as they are solved, then of the new goal shape,
+/// and of one replay, the reported plan's.
 #[test]
 fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::endpoints::EndPose;
-    use dlo_planner::planner::observer::Silent;
+    use dlo_planner::planner::observer::{PathKind, PlanObserver, ShapeRecord};
     use dlo_planner::statics::{SolveStatus, solve_static};
-    let plan = |fields: serde_json::Value| {
+    /// The end shapes and the count of replayed shapes the run passes on.
+    #[derive(Default)]
+    struct Logged(Vec<(f64, Vec<f64>)>, usize);
+    impl PlanObserver for Logged {
+        fn shape(&mut self, _: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
+            match r.kind {
+                PathKind::Endpoint => self.0.push((r.k, r.a.to_vec())),
+                PathKind::Feasible => self.1 += 1,
+                _ => {}
+            }
+        }
+    }
+    let plan = |fields: serde_json::Value, logged: &mut Logged| {
         let mut v: serde_json::Value =
             serde_json::from_str(&spatial_text(4, 65, 26)).expect("JSON");
         merge(
@@ -1488,15 +1502,25 @@ fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
         let path = std::path::Path::new("planning_cases/spatial_4_26.json");
         let c = dlo_planner::case::parse(&v.to_string(), path).expect("a generated case");
         let p = Planner::from_case(&c).expect("start and goal solve");
-        let r = p.run(&mut Silent);
+        let r = p.run(logged);
         (p, r)
     };
-    let (p, r) = plan(serde_json::json!({}));
+    let mut logged = Logged::default();
+    let (p, r) = plan(serde_json::json!({}), &mut logged);
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     let g = r
         .reached_goal
         .as_ref()
         .expect("planned to the reached goal");
+    assert_eq!(
+        logged.0,
+        vec![
+            (0.0, p.start.a.clone()),
+            (1.0, p.goal.a.clone()),
+            (1.0, g.shape.clone())
+        ]
+    );
+    assert_eq!(logged.1, r.replay.steps.len());
     assert!(
         g.first_plan.contains("another equilibrium"),
         "{}",
@@ -1547,7 +1571,10 @@ fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
     assert_eq!(end, g.shape);
     assert!(r.replay.end_deviation_over_l <= r.replay.tolerance);
     // Without it: not executable, for that reason.
-    let (_, off) = plan(serde_json::json!({"plan": {"reached_goal": false}}));
+    let (_, off) = plan(
+        serde_json::json!({"plan": {"reached_goal": false}}),
+        &mut Logged::default(),
+    );
     assert!(!off.verdict().is_executable());
     assert!(off.reached_goal.is_none());
     let why = off.equilibrium_plan.as_ref().and_then(|e| e.reason.clone());
