@@ -351,17 +351,22 @@ fn end_shape(
             }
             (None, None) => problem.initial.clone(),
         };
-        let sol = solve_from(pose.problem(base), &a0, opts);
-        let first = on_chords_if_dipping(
-            base,
-            &problem.obstacles,
-            &pose,
-            sol,
-            fine,
-            opts,
-            coincide_tolerance,
-            false,
-        );
+        // The pose solved from `a`, on the chords where it dips.
+        let solved = |a: &[f64]| {
+            let sol = solve_from(pose.problem(base), a, opts);
+            let obstacles = &problem.obstacles;
+            on_chords_if_dipping(
+                base,
+                obstacles,
+                &pose,
+                sol,
+                fine,
+                opts,
+                coincide_tolerance,
+                false,
+            )
+        };
+        let first = solved(&a0);
         let converged = first.0.status == SolveStatus::Converged;
         if end.shape.is_some() || (converged && !least_energy) {
             first
@@ -386,19 +391,7 @@ fn end_shape(
                 angles,
             )
             .into_iter()
-            .map(|a| {
-                let sol = solve_from(pose.problem(base), &a, opts);
-                on_chords_if_dipping(
-                    base,
-                    &problem.obstacles,
-                    &pose,
-                    sol,
-                    fine,
-                    opts,
-                    coincide_tolerance,
-                    false,
-                )
-            });
+            .map(|a| solved(&a));
             let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
             let best = retried
                 .filter(|(sol, _)| sol.status == SolveStatus::Converged)
