@@ -136,7 +136,7 @@ impl<'a> Recorder<'a> {
     }
 
     /// A recorder that also passes on phases and the optimiser's progress to `inner` (a
-    /// search whose shapes are logged only if its plan is chosen).
+    /// second search, whose shapes are passed on only where its plan is reported).
     pub(crate) fn passing(inner: &'a mut dyn PlanObserver) -> Self {
         Recorder {
             passing: true,

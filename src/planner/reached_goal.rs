@@ -6,10 +6,10 @@
 //! sags one way or another, a strip buckles up or down. Where no plan to that shape executes
 //! but the replay of the best one — the rod's equilibria as the gripper follows its
 //! trajectory — converges, stays stable, never snaps, keeps clear of every obstacle and ends on
-//! another equilibrium of the goal pose, the gripper does bring the rod to the goal pose, in that shape. (Where such
-//! shapes dip into an obstacle between the solves' contact points, they are first replayed on
-//! the chords between them, as any that dip are: the other equilibrium can be the dip's
-//! artefact.) The planner then plans again with that shape as the goal (solved at the goal
+//! another equilibrium of the goal pose, the gripper does bring the rod to the goal pose, in
+//! that shape. (Where such shapes dip into an obstacle between the solves' contact points,
+//! they are first replayed on the chords between them, as any that dip are: the other
+//! equilibrium can be the dip's artefact.) The planner then plans again with that shape as the goal (solved at the goal
 //! shape's end pose, which the replay held), and reports that plan where it is executable,
 //! with both shapes' energies and how far apart they are
 //! ([`super::PlanResult::reached_goal`]). The replay of the new plan is its verdict, as for any
