@@ -75,6 +75,9 @@ impl Planner {
                         dipped,
                     });
                     p.contact_tries = tries;
+                    // Its end solves started from the shapes solved before, not from a shape
+                    // the problem gave.
+                    p.goal_by_pose = own.goal_by_pose;
                     return Ok(p);
                 }
                 still => tries.push(ContactTry {

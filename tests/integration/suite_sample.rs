@@ -421,6 +421,26 @@ fn equilibria_that_dip_and_end_elsewhere_are_replayed_on_chords() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
+/// The suite's planar problem `planar_53_10` (seed 53), planned with the defaults: its start
+/// shape dips into a box between the case's 32 contact samples, so the plan is made with 64,
+/// its end solves started from the shapes solved with 32. Its goal is still a pose alone: the
+/// best plan's replay ends on another equilibrium of the goal pose (0.42 L from the goal
+/// shape), and the plan is made again to that one, executable, clear of the obstacles on a
+/// grid four times finer in s.
+#[test]
+fn a_goal_pose_planned_with_more_contact_samples_is_planned_to_the_reached_goal() {
+    let (p, r) = suite_planar_plan_of(53, 10);
+    assert_eq!(r.contact_samples.as_ref().map(|c| c.samples), Some(64));
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    let g = r
+        .reached_goal
+        .as_ref()
+        .expect("planned to the reached goal");
+    assert!(g.distance_over_l > p.settings.coincide_tolerance);
+    assert!(r.replay.end_deviation_over_l <= r.replay.tolerance);
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+}
+
 /// The equilibria `e` of `p`'s plan are executable on the chords between contact points, held
 /// off the obstacles by a margin within a twentieth of the coincidence tolerance; the margin
 /// (case units).
@@ -636,9 +656,10 @@ fn held_on_the_trajectory_clear_of_obstacles(
             step.k
         );
     }
-    // The last shape is the goal's.
+    // The last shape is the goal's (the one the plan ends on).
     let last = r.replay.steps.last().expect("steps");
-    let goal = model.evaluate(&p.goal.a).positions;
+    let goal_shape = r.reached_goal.as_ref().map_or(&p.goal.a, |g| &g.shape);
+    let goal = model.evaluate(goal_shape).positions;
     let d = last
         .positions
         .iter()
