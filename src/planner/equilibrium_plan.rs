@@ -93,6 +93,18 @@ impl EquilibriumPlan {
         let first = self.reason.take().unwrap_or_default();
         self.reason = Some(format!("{first}; {attempt}: {why}"));
     }
+
+    /// [`Self::retry_failed`] with the reason of `retry`, the equilibria of a second attempt
+    /// (`attempt`: what it changed), which are no plan either; where these reached no other
+    /// equilibrium of the goal pose, the one `retry` reached, if any.
+    pub(super) fn retry_failed_as(&mut self, attempt: &str, retry: &EquilibriumPlan) {
+        if let Some(why) = &retry.reason {
+            self.retry_failed(attempt, why);
+        }
+        if self.reached_goal.is_none() {
+            self.reached_goal.clone_from(&retry.reached_goal);
+        }
+    }
 }
 
 /// `base` with every obstacle contact held on the chords between sample points, or `None` when

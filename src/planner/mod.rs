@@ -476,6 +476,13 @@ fn solve_from(mut p: StaticProblem, a0: &[f64], opts: &StaticOptions) -> StaticS
     sol
 }
 
+/// The static solve of `p` from `a` and the multipliers `a` needs (least squares): it stays on
+/// the equilibrium it starts from, where one from zero multipliers can leave it.
+fn solve_warm_from(p: &mut StaticProblem, a: &[f64], opts: &StaticOptions) -> StaticSolution {
+    let lambda = crate::statics::evaluate_shape(p, a).lambda;
+    crate::statics::solve_static_warm(p, a, &lambda, opts)
+}
+
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
 /// where it dips into an obstacle between them on the end grid `fine` ([`end_grid`]; by more
 /// than the collision tolerance, 1e-6 L) and the same pose solved with the contacts on the
@@ -500,8 +507,7 @@ fn on_chords_if_dipping(
 ) -> (StaticSolution, Option<f64>) {
     let solve = |p: &mut StaticProblem, a: &[f64]| {
         if warm {
-            let lambda = crate::statics::evaluate_shape(p, a).lambda;
-            crate::statics::solve_static_warm(p, a, &lambda, opts)
+            solve_warm_from(p, a, opts)
         } else {
             solve_static(p, a, opts)
         }
@@ -840,12 +846,7 @@ impl Planner {
                     *shapes = rec.into_shapes();
                     return 0.0;
                 }
-                if let Some(why) = &plan.reason {
-                    ep.retry_failed(what, why);
-                }
-                if ep.reached_goal.is_none() {
-                    ep.reached_goal = plan.reached_goal;
-                }
+                ep.retry_failed_as(what, &plan);
                 match plan.min_clearance {
                     Some(c) if plan.dips => -c,
                     _ => 0.0,
@@ -1513,14 +1514,9 @@ impl Planner {
                 judged = s;
                 along_straight = true;
             } else if let (Some(e), Some(s)) =
-                (judged.equilibrium_plan.as_mut(), s.equilibrium_plan)
+                (judged.equilibrium_plan.as_mut(), &s.equilibrium_plan)
             {
-                if let Some(why) = &s.reason {
-                    e.retry_failed("along the straight path's trajectory", why);
-                }
-                if e.reached_goal.is_none() {
-                    e.reached_goal = s.reached_goal;
-                }
+                e.retry_failed_as("along the straight path's trajectory", s);
             }
         }
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;

@@ -19,8 +19,8 @@ use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
 use super::path::DeformationPath;
 use super::replay::max_distance;
 use super::result::{PlanResult, PlanStatus, PlanVerdict, ReachedGoal};
-use super::{Planner, endpoints::EndPose, on_chords_if_dipping};
-use crate::statics::{SolveStatus, solve_static_warm};
+use super::{Planner, endpoints::EndPose, on_chords_if_dipping, solve_warm_from};
+use crate::statics::SolveStatus;
 
 impl Planner {
     /// The path of `result`, a plan of this planner: from the start shape to the goal shape
@@ -108,11 +108,7 @@ impl Planner {
         let model = &self.base.model;
         let goal_positions = model.evaluate(&self.goal.a).positions;
         let pose = EndPose::of(model, &self.goal.a, &goal_positions);
-        // From its shape and the multipliers it needs (least squares): a solve that starts
-        // warm, as the replay's do, stays on the equilibrium it starts from.
-        let mut held = pose.problem(&self.held);
-        let lambda = crate::statics::evaluate_shape(&mut held, a).lambda;
-        let sol = solve_static_warm(&mut held, a, &lambda, &self.static_options);
+        let sol = solve_warm_from(&mut pose.problem(&self.held), a, &self.static_options);
         let tolerance = self.settings.coincide_tolerance;
         let (sol, _) = on_chords_if_dipping(
             &self.held,
