@@ -115,7 +115,7 @@ struct Recorded {
     violation: Option<f64>,
 }
 
-/// Keeps the shapes it is told of, to pass them on later ([`Recorder::flush`]) or never, and
+/// Keeps the shapes it is told of, to pass them on later ([`flush`]) or never, and
 /// asks `inner` whether to stop: a plan judged before it is chosen logs its replay only if it
 /// is chosen.
 pub(crate) struct Recorder<'a> {

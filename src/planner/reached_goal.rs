@@ -15,11 +15,12 @@
 //! ([`super::PlanResult::reached_goal`]). The replay of the new plan is its verdict, as for any
 //! plan; where it is not executable, the first plan is reported, with what the second met.
 
+use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
 use super::path::DeformationPath;
 use super::replay::max_distance;
 use super::result::{PlanResult, PlanStatus, PlanVerdict, ReachedGoal};
-use super::{Planner, endpoints::EndPose, on_chords_if_dipping, solve_warm_from};
+use super::{Planner, endpoints::EndPose};
 use crate::statics::SolveStatus;
 
 impl Planner {

@@ -9,11 +9,12 @@
 //! The optimiser's tie-breaks (the mean energy along the path, the gripper's travel) are not
 //! weighed against it; `docs/results.md` compares its gripper travel with the optimised plans'.
 
+use super::Planner;
+use super::judge::Judged;
 use super::observer::{PlanObserver, Recorder};
 use super::replay::EarlyStop;
 use super::result::EndInside;
 use super::verify::{Verification, attains_end_energy};
-use super::{Judged, Planner};
 use crate::constraints::Constraint;
 
 /// Largest difference of any coefficient (angles in radians, strains) between the start and

@@ -1,5 +1,5 @@
 //! The static solve: the multiplier method on a [`StaticProblem`], its multipliers turned into
-//! reactions ([`super::reactions`]), the moment balance and a stability verdict.
+//! reactions ([`super::reactions`](mod@super::reactions)), the moment balance and a stability verdict.
 
 use crate::optim::augmented_lagrangian::{AlOptions, AlStatus, augmented_lagrangian};
 use crate::rod::energy::EnergyTerms;
