@@ -682,8 +682,8 @@ impl End {
     }
 }
 
-/// The rotation matrix of a unit quaternion `(w, x, y, z)` (its norm 1 to 1e-6, as in a case
-/// file).
+/// The rotation matrix of a unit quaternion `(w, x, y, z)`: its squared norm 1 to 1e-2, then
+/// normalised, as in a case file.
 fn rotation_of(q: [f64; 4]) -> PyResult<[[f64; 3]; 3]> {
     dlo_planner::planner::trajectory::rotation_of_unit_quaternion(q)
         .map_err(|m| input_error(Some("quaternion"), m))

@@ -82,8 +82,16 @@ pub fn speed_limits(
     Ok(Some([v, w]))
 }
 
-/// The rotation of a unit quaternion `(w, x, y, z)`; `Err` names what is wrong when a
-/// component is not finite or the norm is not 1 to 1e-6.
+/// How far from 1 the squared norm of a quaternion written as an orientation may be
+/// ([`rotation_of_unit_quaternion`]): a quaternion written by hand to two or three decimals,
+/// such as `[0.98, 0, -0.2, 0]` (squared norm 1.0004) or `[0.707, 0, 0.707, 0]` (0.9997), is
+/// meant as the unit quaternion it rounds, and is normalised; one farther off is taken for a
+/// mistake. (RViz's check of the quaternions it is given uses the same bound.)
+pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-2;
+
+/// The rotation of a unit quaternion `(w, x, y, z)`, normalised first; `Err` names what is
+/// wrong when a component is not finite or the squared norm is not 1 to
+/// [`QUATERNION_NORM_TOLERANCE`].
 pub fn rotation_of_unit_quaternion(q: [f64; 4]) -> Result<[[f64; 3]; 3], String> {
     if let Some(i) = q.iter().position(|c| !c.is_finite()) {
         return Err(format!(
@@ -91,10 +99,12 @@ pub fn rotation_of_unit_quaternion(q: [f64; 4]) -> Result<[[f64; 3]; 3], String>
             crate::error::Num(q[i])
         ));
     }
-    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-    if (n - 1.0).abs() > 1e-6 {
+    let n2 = q.iter().map(|c| c * c).sum::<f64>();
+    if (n2 - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
         return Err(format!(
-            "must be a unit quaternion [w, x, y, z]: its norm is {n}"
+            "must be a unit quaternion [w, x, y, z] (its squared norm within \
+             {QUATERNION_NORM_TOLERANCE} of 1; it is normalised): its norm is {}",
+            n2.sqrt()
         ));
     }
     Ok(rotation_of_quaternion(q))
@@ -320,6 +330,29 @@ impl Trajectory {
 mod tests {
     use super::*;
     use crate::rod::kinematics::rotation;
+
+    /// A quaternion written to three decimals is the rotation of the unit quaternion it
+    /// rounds; one whose squared norm is off by more than the tolerance is refused.
+    #[test]
+    fn quaternions_written_to_a_few_decimals_are_normalised() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let exact = rotation_of_quaternion([h, 0.0, h, 0.0]);
+        let rounded = rotation_of_unit_quaternion([0.707, 0.0, 0.707, 0.0]).unwrap();
+        for (a, b) in exact.iter().flatten().zip(rounded.iter().flatten()) {
+            assert!((a - b).abs() < 1e-15, "{rounded:?}");
+        }
+        // Squared norms 0.9901 and 1.0099 pass; 0.98 and 1.0201 do not.
+        for (q, ok) in [
+            ([0.99504, 0.0, 0.0, 0.0], true),
+            ([1.00494, 0.0, 0.0, 0.0], true),
+            ([0.98995, 0.0, 0.0, 0.0], false),
+            ([1.01, 0.0, 0.0, 0.0], false),
+        ] {
+            assert_eq!(rotation_of_unit_quaternion(q).is_ok(), ok, "{q:?}");
+        }
+        let err = rotation_of_unit_quaternion([0.0, 0.0, 1.01, 0.0]).unwrap_err();
+        assert!(err.contains("its norm is 1.01"), "{err}");
+    }
 
     #[test]
     fn quaternion_and_matrix_round_trip() {

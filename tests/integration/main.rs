@@ -20,6 +20,7 @@ mod mcap_log;
 mod paper_claims;
 mod planner;
 mod planner_gradients;
+mod readme_example;
 mod self_contact;
 #[path = "../../examples/plan_suite.rs"]
 #[allow(dead_code)]
