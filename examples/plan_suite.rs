@@ -9,6 +9,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"rod": {"radius": 0.03}}'
 //!     cargo run --release --example plan_suite -- --seed 1 --family hanging   # another family
+//!     cargo run --release --example plan_suite -- --seed 1 --family table     # and a 3D one
 //!     cargo run --release --example plan_suite -- --seed 1 --units 0.6,0.02   # L = 0.6, Rf = 0.02
 //!
 //! Planar: a strip (L = 1, Rf = 1, r = 0.005) clamped at the origin along +z (θ(0) = 0), one to
@@ -21,7 +22,9 @@
 //! static shape (or lies inside an obstacle) are generated again and not counted.
 //! The hanging family (`--family hanging`, [`hanging_problem`]), planar problems of another
 //! style that no default was chosen on: a heavy strip clamped along +x, hanging among
-//! obstacles below and beside its clamp.
+//! obstacles below and beside its clamp. The table family (`--family table`,
+//! [`table_problem`]), 3D problems of a third: a heavy cable dragged across a table, past a
+//! cup standing on it.
 //!
 //! For each problem: whether the plan is collision-free (`planned`) and coincides with its
 //! replay, whether the replay snaps, the plan time (end solves, plan, verification and
@@ -188,6 +191,53 @@ pub fn hanging_problem(rng: &mut Rng, i: usize) -> String {
     )
 }
 
+/// A problem of the table family (`--family table`), unlike those the defaults were chosen on:
+/// a heavy cable (weight 2–25 per length, flexural rigidity 1, torsional 0.77, radius 0.01)
+/// clamped by its frame at the origin along +z, lying on a table (a half-space 0.1–0.3 L below
+/// the clamp; x is up) with, in three problems of five, a cup standing on it (a vertical
+/// cylinder of radius 0.03–0.06 and height 0.08–0.15 between the ends' sides); its end moved
+/// from one side of the z axis to the other, 0.01–0.1 L above the table, 0.5–0.85 L out along
+/// z and 0.15–0.4 L to the side, its tangent along the table within 0.5 rad of +z, with a twist.
+pub fn table_problem(rng: &mut Rng, i: usize) -> String {
+    let weight = rng.uniform(2.0, 25.0);
+    let below = rng.uniform(0.1, 0.3);
+    let mut obstacles = vec![format!(
+        r#"{{"name": "table", "shape": {{"type": "half_space", "normal": [1, 0, 0]}}, "position": [{}, 0, 0]}}"#,
+        -below
+    )];
+    if rng.below(5) < 3 {
+        let half = rng.uniform(0.04, 0.075);
+        obstacles.push(format!(
+            r#"{{"name": "cup", "shape": {{"type": "cylinder", "half_height": {half}, "radius": {}}}, "position": [{}, {}, {}], "rotation": [0, 0, 1.5707963267948966]}}"#,
+            rng.uniform(0.03, 0.06),
+            -below + half,
+            rng.uniform(-0.1, 0.1),
+            rng.uniform(0.4, 0.7)
+        ));
+    }
+    let end = |rng: &mut Rng, side: f64| {
+        let yaw = rng.uniform(-0.5, 0.5);
+        format!(
+            r#"{{"position": [{}, {}, {}], "tangent": [0, {}, {}], "twist": {}}}"#,
+            -below + rng.uniform(0.01, 0.1),
+            side * rng.uniform(0.15, 0.4),
+            rng.uniform(0.5, 0.85),
+            yaw.sin(),
+            yaw.cos(),
+            rng.uniform(-0.5, 0.5)
+        )
+    };
+    let (start, goal) = (end(rng, 1.0), end(rng, -1.0));
+    format!(
+        r#"{{"name": "table_{i}", "planar": false,
+  "rod": {{"length": 1.0, "flexural_rigidity": 1.0, "torsional_rigidity": 0.77, "radius": 0.01, "weight_per_length": {weight}}},
+  "constraints": [{{"type": "orientation", "s": 0.0, "theta": 0.0, "phi_plus_psi": 0.0}}],
+  "obstacles": [{}],
+  "plan": {{"start": {start}, "goal": {goal}}}}}"#,
+        obstacles.join(", ")
+    )
+}
+
 pub fn spatial_problem(rng: &mut Rng, i: usize) -> String {
     let n_obs = 1 + rng.below(2);
     let mut obstacles = Vec::new();
@@ -278,6 +328,9 @@ pub struct Outcome {
     /// The plan ends on another equilibrium of the goal pose than its static solve's, which
     /// the gripper's motion reached (`PlanResult::reached_goal`).
     pub reached_goal: bool,
+    /// Of those, the first plan's replayed equilibria, which end on it (the plan made again to
+    /// it was not executable: `ReachedGoal::replanned` false).
+    pub reached_not_replanned: bool,
     /// Why not executable: the verdict, and why the replayed equilibria are not a plan.
     pub why_not: Option<String>,
     pub snaps: bool,
@@ -481,6 +534,7 @@ pub fn run(
         by_equilibria: executed == Some("equilibria"),
         by_straight: executed.is_some() && along_straight,
         reached_goal: r.reached_goal.is_some(),
+        reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned),
         why_not: executed.is_none().then(|| {
             format!(
                 "{}{}",
@@ -574,19 +628,26 @@ fn main() {
     };
     let seed = arg("--seed", 1);
     // `--family hanging`: the planar problems of [`hanging_problem`] instead of the suite's,
-    // and no 3D problems unless `--spatial` asks for them.
-    let hanging = args
+    // and no 3D problems unless `--spatial` asks for them; `--family table`: the 3D problems
+    // of [`table_problem`], and no planar ones unless `--planar` asks for them.
+    let family = args
         .iter()
         .position(|a| a == "--family")
         .and_then(|i| args.get(i + 1))
         .map(|f| {
-            assert!(f == "hanging", "--family: only `hanging`");
-            true
-        })
-        .unwrap_or(false);
-    let n_planar = arg("--planar", 60) as usize;
+            assert!(
+                f == "hanging" || f == "table",
+                "--family: `hanging` or `table`"
+            );
+            f.clone()
+        });
+    let hanging = family.as_deref() == Some("hanging");
+    let on_table = family.as_deref() == Some("table");
+    let n_planar = arg("--planar", if on_table { 0 } else { 60 }) as usize;
     let n_spatial = arg("--spatial", if hanging { 0 } else { 30 }) as usize;
     let planar_kind = if hanging { "hanging" } else { "planar" };
+    let spatial_kind = if on_table { "table" } else { "spatial" };
+    let spatial_label = if on_table { "table" } else { "3D" };
     let verbose = args.iter().any(|a| a == "--verbose");
     // `--write DIR`: every generated case file is written there, for `dlo plan DIR/NAME.json`
     // (with the `--units`, `--plan` and `--case` it is planned with).
@@ -639,6 +700,8 @@ fn main() {
             hanging_problem(rng, i)
         } else if kind == 0 {
             planar_problem(rng, i)
+        } else if on_table {
+            table_problem(rng, i)
         } else {
             spatial_problem(rng, i)
         };
@@ -663,7 +726,7 @@ fn main() {
     for (kind, count) in [(0, n_planar), (1, n_spatial)] {
         let mut i = 0;
         while results[kind].len() < count {
-            let name = format!("{}_{seed}_{i}", [planar_kind, "spatial"][kind]);
+            let name = format!("{}_{seed}_{i}", [planar_kind, spatial_kind][kind]);
             let text = generate(kind, &mut rng, i);
             i += 1;
             if let Some(dir) = &write_dir {
@@ -720,7 +783,12 @@ fn main() {
                             o.replay.2,
                             o.attempts
                         );
-                        if o.reached_goal {
+                        if o.reached_not_replanned {
+                            eprintln!(
+                                "{:16} executable by its first plan's equilibria, which end on another equilibrium of the goal pose",
+                                o.name
+                            );
+                        } else if o.reached_goal {
                             eprintln!(
                                 "{:16} planned to the equilibrium of the goal pose its first plan's motion reached",
                                 o.name
@@ -737,7 +805,7 @@ fn main() {
         }
     }
     println!(
-        "Suite seed {seed}: {} {planar_kind} and {} 3D problems (generated again where start or goal has no static shape: {} {planar_kind}, {} 3D){}, planner settings {}{}.\n",
+        "Suite seed {seed}: {} {planar_kind} and {} {spatial_label} problems (generated again where start or goal has no static shape: {} {planar_kind}, {} {spatial_label}){}, planner settings {}{}.\n",
         n_planar,
         n_spatial,
         regenerated[0],
@@ -760,9 +828,11 @@ fn main() {
         "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    print!("{}", table(planar_kind, &results[0]));
+    if n_planar > 0 {
+        print!("{}", table(planar_kind, &results[0]));
+    }
     if n_spatial > 0 {
-        print!("{}", table("3D", &results[1]));
+        print!("{}", table(spatial_label, &results[1]));
     }
     // A plan called collision-free (or executable by its replayed equilibria) that the finer
     // check finds inside an obstacle fails the run.

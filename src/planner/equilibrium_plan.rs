@@ -164,9 +164,10 @@ pub fn k_list(ks: &[f64]) -> String {
 }
 
 /// What keeps a replay's shapes from being a plan, if anything: the first failing check of
-/// [`EquilibriumPlan::executable`] other than the confirmation.
-fn failure(first: &Replay) -> Option<String> {
-    failure_on_the_way(first).or_else(|| ends_elsewhere(first))
+/// [`EquilibriumPlan::executable`] other than the confirmation. A replay may end on `ends_on`
+/// (positions, units of L: another equilibrium of the goal pose) instead of the goal shape.
+fn failure(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<String> {
+    failure_on_the_way(first).or_else(|| ends_elsewhere(first, ends_on))
 }
 
 /// The checks of [`failure`] before the goal: every solve converged, nothing snaps, every shape
@@ -199,10 +200,16 @@ fn failure_on_the_way(first: &Replay) -> Option<String> {
     None
 }
 
-/// Where the replay's last shape is not the goal shape: why (the goal pose holds another
-/// equilibrium there).
-fn ends_elsewhere(first: &Replay) -> Option<String> {
-    (first.end_deviation_over_l > first.tolerance).then(|| {
+/// Where the replay's last shape is not the goal shape (nor within the tolerance of `ends_on`,
+/// where given): why (the goal pose holds another equilibrium there).
+fn ends_elsewhere(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<String> {
+    let on_other = |p: &[[f64; 3]]| {
+        first
+            .steps
+            .last()
+            .is_some_and(|s| s.k == 1.0 && max_distance(&s.positions, p) <= first.tolerance)
+    };
+    (first.end_deviation_over_l > first.tolerance && !ends_on.is_some_and(on_other)).then(|| {
         format!(
             "the replay ends {:.3e} L from the goal shape: the goal pose holds another equilibrium there",
             first.end_deviation_over_l
@@ -272,7 +279,7 @@ impl Planner {
             .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
         let mut plan = EquilibriumPlan {
             executable: false,
-            reason: failure(first),
+            reason: failure(first, self.ends_on.as_deref().map(Vec::as_slice)),
             u_max,
             k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
             min_clearance: first.min_clearance,
@@ -360,7 +367,7 @@ impl Planner {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        plan.reason = failure(&second)
+        plan.reason = failure(&second, self.ends_on.as_deref().map(Vec::as_slice))
             .or(why)
             .map(|r| format!("the confirmation replay on {} steps: {r}", opts.steps))
             .or_else(|| {

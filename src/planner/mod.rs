@@ -194,6 +194,11 @@ pub struct Planner {
     /// Judgements replay equilibria that still dip on [`Planner::finer_contacts`]: set on the
     /// copy that judges the search's plans again where none was executable.
     finer_retry: bool,
+    /// Positions (units of L) of an equilibrium of the goal pose, other than the goal shape,
+    /// on which replayed equilibria may end: set on the copy that judges a plan's equilibria
+    /// again where the gripper's motion reaches that equilibrium and no plan to it executes
+    /// ([`PlanSettings::reached_goal`]).
+    ends_on: Option<Arc<Vec<[f64; 3]>>>,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
@@ -424,6 +429,7 @@ impl Planner {
             timed_out: Arc::new(AtomicBool::new(false)),
             quick: false,
             goal_by_pose: problem.goal.is_pose() && problem.goal.shape.is_none(),
+            ends_on: None,
             finer_retry: false,
             workers: workers::Workers::new(settings.threads()),
             end_grid: Arc::new((verify_s, fine)),

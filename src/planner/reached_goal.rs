@@ -18,10 +18,13 @@
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
 use super::path::DeformationPath;
-use super::replay::max_distance;
+use super::replay::{EarlyStop, max_distance};
 use super::result::{PlanResult, PlanStatus, PlanVerdict, ReachedGoal};
+use super::trajectory::Trajectory;
+use super::verify::fine_model;
 use super::{Planner, endpoints::EndPose};
 use crate::statics::SolveStatus;
+use std::sync::Arc;
 
 impl Planner {
     /// The path of `result`, a plan of this planner: from the start shape to the goal shape
@@ -29,7 +32,7 @@ impl Planner {
     /// terms; its unknowns are `result.z`.
     pub fn path_of(&self, result: &PlanResult) -> DeformationPath {
         let mut p = self.with_terms(result.path_terms);
-        if let Some(g) = &result.reached_goal {
+        if let Some(g) = result.reached_goal.as_ref().filter(|g| g.replanned) {
             p.goal.a = g.shape.clone();
         }
         p.path()
@@ -66,7 +69,6 @@ impl Planner {
             again.reached_goal = Some(reached);
             return again;
         }
-        flush(&replayed, model, observer);
         // A run stopped during the second search is a stopped run.
         if again.status == PlanStatus::Interrupted {
             result.status = PlanStatus::Interrupted;
@@ -74,6 +76,38 @@ impl Planner {
         result.timing_s.plan += again.timing_s.plan;
         result.timing_s.replay += again.timing_s.replay;
         result.time_limit_reached |= again.time_limit_reached;
+        // The first plan's equilibria, which bring the rod to that equilibrium of the goal
+        // pose, judged again with that end accepted (every other check as before).
+        let along_optimal = result
+            .equilibrium_plan
+            .as_ref()
+            .is_some_and(|e| e.trajectory == "optimal_path");
+        if along_optimal && !self.stopped() && !self.time_up() {
+            let accepting = Planner {
+                ends_on: Some(Arc::new(model.evaluate(&reached.shape).positions)),
+                ..self.clone()
+            };
+            let path = self.path_of(&result);
+            let fine = fine_model(model, self.verify_s_intervals(), 4);
+            let planned = result.status == PlanStatus::Planned;
+            let j =
+                accepting.judge_path(&path, &result.z, planned, EarlyStop::Never, &fine, observer);
+            result.timing_s.replay += j.seconds;
+            if j.executable {
+                flush(&j.shapes, model, observer);
+                let ks: Vec<f64> = j.replay.steps.iter().map(|s| s.k).collect();
+                result.trajectory = Trajectory::along(model, &path, &result.z, &ks);
+                result.replay = j.replay;
+                result.equilibrium_plan = j.equilibrium_plan;
+                result.workspace = j.workspace.or(result.workspace);
+                reached.first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
+                reached.replanned = false;
+                reached.replan_failed = Some(again.verdict().to_string());
+                result.reached_goal = Some(reached);
+                return result;
+            }
+        }
+        flush(&replayed, model, observer);
         if let Some(e) = result.equilibrium_plan.as_mut() {
             e.retry_failed(
                 &format!(
@@ -140,6 +174,8 @@ impl Planner {
             },
             first_plan_seconds: 0.0,
             shape: sol.a.clone(),
+            replanned: true,
+            replan_failed: None,
         };
         let mut planner = self.clone();
         planner.goal = sol;

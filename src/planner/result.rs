@@ -279,11 +279,19 @@ pub struct ReachedGoal {
     pub energy: f64,
     /// Largest distance between the two shapes (fraction of L).
     pub distance_over_l: f64,
-    /// Ritz coefficients of the goal shape the plan ends on (the plan's path runs from the
-    /// start shape to it: [`super::Planner::path_of`]).
+    /// Ritz coefficients of the goal shape the plan ends on (where [`ReachedGoal::replanned`],
+    /// the plan's path runs from the start shape to it: [`super::Planner::path_of`]).
     pub shape: Vec<f64>,
+    /// The plan was made again to this goal shape and is that plan; else (its plan was not
+    /// executable) the plan is the first plan's replayed equilibria, which end on it, and the
+    /// first plan's path still ends on the goal shape the static solve found.
+    pub replanned: bool,
     /// Why the first plan was not executable: its verdict and what its equilibria met.
     pub first_plan: String,
+    /// Where not [`ReachedGoal::replanned`]: why the plan made again to this goal shape was not
+    /// executable (its verdict).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replan_failed: Option<String>,
     /// Seconds the first plan's search took (in [`PlanResult::timing_s`] too).
     pub first_plan_seconds: f64,
 }
