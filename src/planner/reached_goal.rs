@@ -13,7 +13,10 @@
 //! shape's end pose, which the replay held), and reports that plan where it is executable,
 //! with both shapes' energies and how far apart they are
 //! ([`super::PlanResult::reached_goal`]). The replay of the new plan is its verdict, as for any
-//! plan; where it is not executable, the first plan is reported, with what the second met.
+//! plan. Where it is not executable, the first plan's replayed equilibria, which end on that
+//! equilibrium, are judged again with it accepted as their end, every other check as before;
+//! where they pass they are the plan (`replanned` false), else the first plan is reported, with
+//! what the second met.
 
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
@@ -40,8 +43,10 @@ impl Planner {
 
     /// `result`, or, where it is not executable and the gripper's motion along its trajectory
     /// reached another equilibrium of a goal given by its pose alone, the plan to that
-    /// equilibrium where that one is executable; with the reported plan's replayed shapes
-    /// (`replayed`, or the second search's) passed on to `observer`. The second search's other
+    /// equilibrium where that one is executable, else `result` with its replayed equilibria
+    /// judged again with that end accepted, where they pass; with the reported plan's replayed
+    /// shapes (`replayed`, the second search's or the second judgement's) passed on to
+    /// `observer`. The second search's other
     /// shapes are not passed on but for its goal shape, at `k = 1` after the first's: the
     /// first search's end shapes and straight path were passed on as they came, and a log
     /// holds one of each along `k` (its optimiser's progress is passed on as it comes).
@@ -73,6 +78,7 @@ impl Planner {
         if again.status == PlanStatus::Interrupted {
             result.status = PlanStatus::Interrupted;
         }
+        let first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
         result.timing_s.plan += again.timing_s.plan;
         result.timing_s.replay += again.timing_s.replay;
         result.time_limit_reached |= again.time_limit_reached;
@@ -94,13 +100,14 @@ impl Planner {
                 accepting.judge_path(&path, &result.z, planned, EarlyStop::Never, &fine, observer);
             result.timing_s.replay += j.seconds;
             if j.executable {
+                flush(&searched.goal_shape(), model, observer);
                 flush(&j.shapes, model, observer);
                 let ks: Vec<f64> = j.replay.steps.iter().map(|s| s.k).collect();
                 result.trajectory = Trajectory::along(model, &path, &result.z, &ks);
                 result.replay = j.replay;
                 result.equilibrium_plan = j.equilibrium_plan;
                 result.workspace = j.workspace.or(result.workspace);
-                reached.first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
+                reached.first_plan_seconds = first_plan_seconds;
                 reached.replanned = false;
                 reached.replan_failed = Some(again.verdict().to_string());
                 result.reached_goal = Some(reached);

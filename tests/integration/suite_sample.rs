@@ -1629,22 +1629,43 @@ fn holds_the_goals_end_pose(p: &dlo_planner::planner::Planner, a: &[f64]) {
 #[test]
 fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     use dlo_planner::planner::Planner;
-    let plan = |fields: serde_json::Value| {
+    use dlo_planner::planner::observer::{PathKind, PlanObserver, ShapeRecord};
+    /// The end shapes the run passes on.
+    #[derive(Default)]
+    struct Ends(Vec<(f64, Vec<f64>)>);
+    impl PlanObserver for Ends {
+        fn shape(&mut self, _: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
+            if r.kind == PathKind::Endpoint {
+                self.0.push((r.k, r.a.to_vec()));
+            }
+        }
+    }
+    let plan = |fields: serde_json::Value, ends: &mut Ends| {
         let mut v: serde_json::Value =
             serde_json::from_str(&nth_problem(table_problem, 2, 16)).expect("JSON");
         merge(&mut v, &fields);
         let path = std::path::Path::new("table_2_16.json");
         let c = dlo_planner::case::parse(&v.to_string(), path).expect("a generated case");
         let p = Planner::from_case(&c).expect("start and goal solve");
-        let r = p.run(&mut dlo_planner::planner::observer::Silent);
+        let r = p.run(ends);
         (p, r)
     };
-    let (p, r) = plan(serde_json::json!({}));
+    let mut ends = Ends::default();
+    let (p, r) = plan(serde_json::json!({}), &mut ends);
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
     let g = r.reached_goal.as_ref().expect("a reached goal");
     assert!(!g.replanned);
     assert!(g.replan_failed.is_some());
+    // The log gets the reached equilibrium at k = 1 after the goal shape.
+    assert_eq!(
+        ends.0,
+        vec![
+            (0.0, p.start.a.clone()),
+            (1.0, p.goal.a.clone()),
+            (1.0, g.shape.clone())
+        ]
+    );
     assert!(
         g.first_plan.contains("another equilibrium"),
         "{}",
@@ -1666,6 +1687,9 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     let mut end = vec![0.0; path.n()];
     path.shape_at(&r.z, 1.0, &mut end);
     assert_eq!(end, p.goal.a);
-    let (_, off) = plan(serde_json::json!({"plan": {"reached_goal": false}}));
+    let (_, off) = plan(
+        serde_json::json!({"plan": {"reached_goal": false}}),
+        &mut Ends::default(),
+    );
     fails_for_another_equilibrium(&off);
 }
