@@ -1483,6 +1483,55 @@ fn the_report_gives_a_thin_rods_finer_verification_grid() {
     }
 }
 
+/// The generated case `text` (named `name`) with `fields` merged in, planned with the defaults,
+/// its shapes passed on to `observer`.
+fn planned_with(
+    text: &str,
+    name: &str,
+    fields: &serde_json::Value,
+    observer: &mut dyn dlo_planner::planner::observer::PlanObserver,
+) -> (
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::PlanResult,
+) {
+    let mut v: serde_json::Value = serde_json::from_str(text).expect("JSON");
+    merge(&mut v, fields);
+    let c = dlo_planner::case::parse(&v.to_string(), std::path::Path::new(name))
+        .expect("a generated case");
+    let p = dlo_planner::planner::Planner::from_case(&c).expect("start and goal solve");
+    let r = p.run(observer);
+    (p, r)
+}
+
+/// The end shapes a run to a reached goal `reached` passes on: the start and goal shapes, then
+/// the reached one at k = 1.
+fn end_shapes(p: &dlo_planner::planner::Planner, reached: &[f64]) -> Vec<(f64, Vec<f64>)> {
+    vec![
+        (0.0, p.start.a.clone()),
+        (1.0, p.goal.a.clone()),
+        (1.0, reached.to_vec()),
+    ]
+}
+
+/// The end shapes and the count of replayed shapes a run passes on.
+#[derive(Default)]
+struct Logged(Vec<(f64, Vec<f64>)>, usize);
+
+impl dlo_planner::planner::observer::PlanObserver for Logged {
+    fn shape(
+        &mut self,
+        _: &dlo_planner::rod::model::Model,
+        r: &dlo_planner::planner::observer::ShapeRecord,
+    ) {
+        use dlo_planner::planner::observer::PathKind;
+        match r.kind {
+            PathKind::Endpoint => self.0.push((r.k, r.a.to_vec())),
+            PathKind::Feasible => self.1 += 1,
+            _ => {}
+        }
+    }
+}
+
 /// The suite's 3D problem `spatial_4_26` (seed 4) with a heavy cable, weight 10 per length
 /// (`plan_suite --seed 4 --only 3d --case '{"rod": {"weight_per_length": 10}}'`). Its goal is
 /// a pose alone. No plan to the goal shape its static solve found is executable: the gripper's
@@ -1497,35 +1546,16 @@ fn the_report_gives_a_thin_rods_finer_verification_grid() {
 /// and of one replay, the reported plan's.
 #[test]
 fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
-    use dlo_planner::planner::Planner;
     use dlo_planner::planner::endpoints::EndPose;
-    use dlo_planner::planner::observer::{PathKind, PlanObserver, ShapeRecord};
     use dlo_planner::statics::{SolveStatus, solve_static};
-    /// The end shapes and the count of replayed shapes the run passes on.
-    #[derive(Default)]
-    struct Logged(Vec<(f64, Vec<f64>)>, usize);
-    impl PlanObserver for Logged {
-        fn shape(&mut self, _: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
-            match r.kind {
-                PathKind::Endpoint => self.0.push((r.k, r.a.to_vec())),
-                PathKind::Feasible => self.1 += 1,
-                _ => {}
-            }
-        }
-    }
+    let mut heavy: serde_json::Value =
+        serde_json::from_str(&spatial_text(4, 65, 26)).expect("JSON");
+    merge(
+        &mut heavy,
+        &serde_json::json!({"rod": {"weight_per_length": 10}}),
+    );
     let plan = |fields: serde_json::Value, logged: &mut Logged| {
-        let mut v: serde_json::Value =
-            serde_json::from_str(&spatial_text(4, 65, 26)).expect("JSON");
-        merge(
-            &mut v,
-            &serde_json::json!({"rod": {"weight_per_length": 10}}),
-        );
-        merge(&mut v, &fields);
-        let path = std::path::Path::new("planning_cases/spatial_4_26.json");
-        let c = dlo_planner::case::parse(&v.to_string(), path).expect("a generated case");
-        let p = Planner::from_case(&c).expect("start and goal solve");
-        let r = p.run(logged);
-        (p, r)
+        planned_with(&heavy.to_string(), "spatial_4_26.json", &fields, logged)
     };
     let mut logged = Logged::default();
     let (p, r) = plan(serde_json::json!({}), &mut logged);
@@ -1534,14 +1564,7 @@ fn a_goal_pose_is_planned_again_to_the_equilibrium_the_motion_reaches() {
         .reached_goal
         .as_ref()
         .expect("planned to the reached goal");
-    assert_eq!(
-        logged.0,
-        vec![
-            (0.0, p.start.a.clone()),
-            (1.0, p.goal.a.clone()),
-            (1.0, g.shape.clone())
-        ]
-    );
+    assert_eq!(logged.0, end_shapes(&p, &g.shape));
     assert_eq!(logged.1, r.replay.steps.len());
     assert!(
         g.first_plan.contains("another equilibrium"),
@@ -1628,29 +1651,11 @@ fn holds_the_goals_end_pose(p: &dlo_planner::planner::Planner, a: &[f64]) {
 /// other equilibrium.
 #[test]
 fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
-    use dlo_planner::planner::Planner;
-    use dlo_planner::planner::observer::{PathKind, PlanObserver, ShapeRecord};
-    /// The end shapes the run passes on.
-    #[derive(Default)]
-    struct Ends(Vec<(f64, Vec<f64>)>);
-    impl PlanObserver for Ends {
-        fn shape(&mut self, _: &dlo_planner::rod::model::Model, r: &ShapeRecord) {
-            if r.kind == PathKind::Endpoint {
-                self.0.push((r.k, r.a.to_vec()));
-            }
-        }
-    }
-    let plan = |fields: serde_json::Value, ends: &mut Ends| {
-        let mut v: serde_json::Value =
-            serde_json::from_str(&nth_problem(table_problem, 2, 16)).expect("JSON");
-        merge(&mut v, &fields);
-        let path = std::path::Path::new("table_2_16.json");
-        let c = dlo_planner::case::parse(&v.to_string(), path).expect("a generated case");
-        let p = Planner::from_case(&c).expect("start and goal solve");
-        let r = p.run(ends);
-        (p, r)
+    let text = nth_problem(table_problem, 2, 16);
+    let plan = |fields: serde_json::Value, ends: &mut Logged| {
+        planned_with(&text, "table_2_16.json", &fields, ends)
     };
-    let mut ends = Ends::default();
+    let mut ends = Logged::default();
     let (p, r) = plan(serde_json::json!({}), &mut ends);
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
@@ -1658,14 +1663,7 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     assert!(!g.replanned);
     assert!(g.replan_failed.is_some());
     // The log gets the reached equilibrium at k = 1 after the goal shape.
-    assert_eq!(
-        ends.0,
-        vec![
-            (0.0, p.start.a.clone()),
-            (1.0, p.goal.a.clone()),
-            (1.0, g.shape.clone())
-        ]
-    );
+    assert_eq!(ends.0, end_shapes(&p, &g.shape));
     assert!(
         g.first_plan.contains("another equilibrium"),
         "{}",
@@ -1689,7 +1687,7 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     assert_eq!(end, p.goal.a);
     let (_, off) = plan(
         serde_json::json!({"plan": {"reached_goal": false}}),
-        &mut Ends::default(),
+        &mut Logged::default(),
     );
     fails_for_another_equilibrium(&off);
 }
