@@ -329,7 +329,7 @@ pub struct Outcome {
     /// the gripper's motion reached (`PlanResult::reached_goal`).
     pub reached_goal: bool,
     /// Of those, the first plan's replayed equilibria, which end on it (the plan made again to
-    /// it was not executable: `ReachedGoal::replanned` false).
+    /// it was not executable: `ReachedGoal::replan_failed`).
     pub reached_not_replanned: bool,
     /// Why not executable: the verdict, and why the replayed equilibria are not a plan.
     pub why_not: Option<String>,
@@ -534,7 +534,7 @@ pub fn run(
         by_equilibria: executed == Some("equilibria"),
         by_straight: executed.is_some() && along_straight,
         reached_goal: r.reached_goal.is_some(),
-        reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned),
+        reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned()),
         why_not: executed.is_none().then(|| {
             format!(
                 "{}{}",

@@ -15,7 +15,7 @@
 //! ([`super::PlanResult::reached_goal`]). The replay of the new plan is its verdict, as for any
 //! plan. Where it is not executable, the first plan's replayed equilibria, which end on that
 //! equilibrium, are judged again with it accepted as their end, every other check as before;
-//! where they pass they are the plan (`replanned` false), else the first plan is reported, with
+//! where they pass they are the plan (with `replan_failed`), else the first plan is reported, with
 //! what the second met.
 
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
@@ -31,11 +31,11 @@ use std::sync::Arc;
 
 impl Planner {
     /// The path of `result`, a plan of this planner: from the start shape to the goal shape
-    /// it ends on (the goal's solve, or [`PlanResult::reached_goal`]'s shape), with its path
-    /// terms; its unknowns are `result.z`.
+    /// its optimiser planned to (the goal's solve, or the shape of a [`PlanResult::reached_goal`]
+    /// planned again to), with its path terms; its unknowns are `result.z`.
     pub fn path_of(&self, result: &PlanResult) -> DeformationPath {
         let mut p = self.with_terms(result.path_terms);
-        if let Some(g) = result.reached_goal.as_ref().filter(|g| g.replanned) {
+        if let Some(g) = result.reached_goal.as_ref().filter(|g| g.replanned()) {
             p.goal.a = g.shape.clone();
         }
         p.path()
@@ -65,10 +65,10 @@ impl Planner {
         recorder.phase("reached goal");
         let (mut again, again_replayed) = planner.search(&mut recorder);
         let searched = recorder.into_shapes();
+        reached.first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
         if again.verdict().is_executable() {
             flush(&searched.goal_shape(), model, observer);
             flush(&again_replayed, model, observer);
-            reached.first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
             again.timing_s.plan += result.timing_s.plan;
             again.timing_s.replay += result.timing_s.replay;
             again.reached_goal = Some(reached);
@@ -78,7 +78,6 @@ impl Planner {
         if again.status == PlanStatus::Interrupted {
             result.status = PlanStatus::Interrupted;
         }
-        let first_plan_seconds = result.timing_s.plan + result.timing_s.replay;
         result.timing_s.plan += again.timing_s.plan;
         result.timing_s.replay += again.timing_s.replay;
         result.time_limit_reached |= again.time_limit_reached;
@@ -107,8 +106,6 @@ impl Planner {
                 result.replay = j.replay;
                 result.equilibrium_plan = j.equilibrium_plan;
                 result.workspace = j.workspace.or(result.workspace);
-                reached.first_plan_seconds = first_plan_seconds;
-                reached.replanned = false;
                 reached.replan_failed = Some(again.verdict().to_string());
                 result.reached_goal = Some(reached);
                 return result;
@@ -181,7 +178,6 @@ impl Planner {
             },
             first_plan_seconds: 0.0,
             shape: sol.a.clone(),
-            replanned: true,
             replan_failed: None,
         };
         let mut planner = self.clone();

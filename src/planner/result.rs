@@ -270,7 +270,9 @@ pub struct PlanResult {
 /// The goal shape a plan ends on where it is not the one the goal pose's static solve found
 /// ([`PlanResult::reached_goal`]): no plan to that one was executable, and the gripper's
 /// motion along the best plan's trajectory brought the rod to this equilibrium of the same
-/// pose (stable, clear of the obstacles), so the plan was made again to it.
+/// pose (stable, clear of the obstacles), so the plan was made again to it, or, where that
+/// plan was not executable, that motion's replayed equilibria are the plan
+/// ([`ReachedGoal::replanned`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct ReachedGoal {
     /// Internal energy of the goal shape the static solve found (case units).
@@ -282,18 +284,24 @@ pub struct ReachedGoal {
     /// Ritz coefficients of the goal shape the plan ends on (where [`ReachedGoal::replanned`],
     /// the plan's path runs from the start shape to it: [`super::Planner::path_of`]).
     pub shape: Vec<f64>,
-    /// The plan was made again to this goal shape and is that plan; else (its plan was not
-    /// executable) the plan is the first plan's replayed equilibria, which end on it, and the
-    /// first plan's path still ends on the goal shape the static solve found.
-    pub replanned: bool,
     /// Why the first plan was not executable: its verdict and what its equilibria met.
     pub first_plan: String,
-    /// Where not [`ReachedGoal::replanned`]: why the plan made again to this goal shape was not
-    /// executable (its verdict).
+    /// Where the plan made again to this goal shape was not executable: its verdict; the plan
+    /// is then the first plan's replayed equilibria, which end on this shape, and the first
+    /// plan's path still ends on the goal shape the static solve found. Absent where the plan
+    /// is the one made again ([`ReachedGoal::replanned`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replan_failed: Option<String>,
     /// Seconds the first plan's search took (in [`PlanResult::timing_s`] too).
     pub first_plan_seconds: f64,
+}
+
+impl ReachedGoal {
+    /// The plan was made again to this goal shape and is that plan (no
+    /// [`ReachedGoal::replan_failed`]).
+    pub fn replanned(&self) -> bool {
+        self.replan_failed.is_none()
+    }
 }
 
 impl PlanResult {

@@ -1660,7 +1660,7 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
     let g = r.reached_goal.as_ref().expect("a reached goal");
-    assert!(!g.replanned);
+    assert!(!g.replanned());
     assert!(g.replan_failed.is_some());
     // The log gets the reached equilibrium at k = 1 after the goal shape.
     assert_eq!(ends.0, end_shapes(&p, &g.shape));

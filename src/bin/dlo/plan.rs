@@ -492,7 +492,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             "  goal shape: the equilibrium of the goal pose the gripper's motion reached (energy {:.6e}), {:.3e} L from the one its static solve found (energy {:.6e}); the plan to that one: {}",
             g.energy, g.distance_over_l, g.solved_energy, g.first_plan
         );
-        if let Some(why) = g.replan_failed.as_ref().filter(|_| !g.replanned) {
+        if let Some(why) = &g.replan_failed {
             let _ = writeln!(
                 o,
                 "  the plan is the first plan's replayed equilibria, which end on it (the plan made again to it: {why})"
