@@ -277,9 +277,15 @@ impl Planner {
         let (iu, u_max) = super::replay::equilibrium_steps(&first.steps)
             .map(|(i, s)| (i, s.u_feasible))
             .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+        // The replay may end on another equilibrium of the goal pose where the planner accepts
+        // one ([`Planner::ends_on`]).
+        let ends_on = self.ends_on.as_deref().map(Vec::as_slice);
+        let on_the_way = failure_on_the_way(first);
         let mut plan = EquilibriumPlan {
             executable: false,
-            reason: failure(first, self.ends_on.as_deref().map(Vec::as_slice)),
+            reason: on_the_way
+                .clone()
+                .or_else(|| ends_elsewhere(first, ends_on)),
             u_max,
             k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
             min_clearance: first.min_clearance,
@@ -308,7 +314,7 @@ impl Planner {
             plan.reason = why;
             plan.min_clearance = clearance;
             plan.dips = dips;
-        } else if failure_on_the_way(first).is_none() {
+        } else if on_the_way.is_none() {
             // It ends on another equilibrium of the goal pose: where its shapes keep clear, the
             // gripper's motion reaches it (a plan to it is judged on its own,
             // [`super::reached_goal`]); where they dip between the solves' contact points, it
@@ -367,7 +373,7 @@ impl Planner {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        plan.reason = failure(&second, self.ends_on.as_deref().map(Vec::as_slice))
+        plan.reason = failure(&second, ends_on)
             .or(why)
             .map(|r| format!("the confirmation replay on {} steps: {r}", opts.steps))
             .or_else(|| {
