@@ -89,6 +89,14 @@ impl ObstacleConstraint {
             }
             let (dh, nh) = at(0.5);
             let w = if slope(nh) <= 0.0 {
+                // Still falling at the middle: where it falls all the way to the neighbour, the
+                // chord comes closest at the neighbour itself, which its own row keeps clear
+                // (a chord along a flat face: the row stays the point's, smooth, instead of
+                // switching to the midpoint as the chord tilts); otherwise its minimum lies in
+                // the neighbour's half, and the middle joins this row to that one continuously.
+                if slope(at(1.0).1) <= 0.0 {
+                    continue;
+                }
                 (0.5, dh, nh)
             } else {
                 let (mut lo, mut hi) = (0.0, 0.5);
@@ -268,5 +276,63 @@ fn clearances_body(c: &ObstacleConstraint, positions: &[[f64; 3]], out: &mut [f6
         for o in o.iter_mut() {
             *o = c.clearance - *o / c.length;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ObstacleConstraint;
+    use crate::scene::obstacle::{Obstacle, ObstacleShape};
+    use std::sync::Arc;
+
+    /// Rows on the chords of three sample points `xs` (case units, `L = 1`) near `shape`.
+    fn witnesses(shape: ObstacleShape, xs: [[f64; 3]; 3]) -> Vec<super::Witness> {
+        let c = ObstacleConstraint {
+            obstacle: Arc::new(Obstacle::new("o".into(), shape, [0.0; 3], [0.0; 3])),
+            samples: vec![0, 1, 2],
+            clearance: 0.01,
+            length: 1.0,
+            chords: true,
+        };
+        (0..3).map(|j| c.witness(&xs, j)).collect()
+    }
+
+    /// Along a flat face a chord comes closest at one of its ends, which that end's own row
+    /// keeps clear: each row is its own point's distance, however the chords tilt (a rod lying
+    /// on a table has smooth rows, none switching to a chord's middle as it slides).
+    #[test]
+    fn rows_along_a_flat_face_are_their_points() {
+        let table = || ObstacleShape::half_space([0.0, 0.0, 1.0]).unwrap();
+        for tilt in [-1e-3, 0.0, 1e-3] {
+            let xs = [
+                [0.0, 0.0, 0.011],
+                [0.05, 0.0, 0.011 + tilt],
+                [0.1, 0.0, 0.011],
+            ];
+            for (j, w) in witnesses(table(), xs).iter().enumerate() {
+                assert_eq!(w.t, 0.0, "row {j}, tilt {tilt}");
+                assert_eq!(w.towards, j);
+                assert!((w.distance - xs[j][2]).abs() < 1e-15);
+            }
+        }
+    }
+
+    /// Across a ball a chord dips below both its ends: the row whose half holds the chord's
+    /// lowest point takes it, so that the polyline keeps clear.
+    #[test]
+    fn a_chord_across_a_ball_keeps_its_lowest_point() {
+        let (r, h) = (0.1, 0.105);
+        let xs = [[-0.2, 0.0, 0.0], [-0.03, 0.0, h], [0.05, 0.0, h]];
+        let w = witnesses(ObstacleShape::ball(r), xs);
+        // Between points 1 and 2 the chord passes over the ball's top at x = 0, three eighths
+        // of the way from 1 towards 2: in point 1's half.
+        let from_1 = w[1];
+        assert_eq!(from_1.towards, 2);
+        assert!((from_1.t - 0.375).abs() < 1e-9, "{}", from_1.t);
+        assert!((from_1.distance - (h - r)).abs() < 1e-9);
+        // Point 2's row, whose half does not hold it, keeps the chord's middle, which joins
+        // the two rows continuously as the lowest point crosses it.
+        assert_eq!((w[2].towards, w[2].t), (1, 0.5));
+        assert!(w[2].distance > from_1.distance);
     }
 }
