@@ -325,6 +325,9 @@ pub struct Outcome {
     pub by_equilibria: bool,
     /// Of those, along the straight-line path's trajectory (no optimised path executable).
     pub by_straight: bool,
+    /// Of those, along a line in the end's pose space (neither an optimised path nor the
+    /// straight-line path's trajectory executable): its lift (units of L).
+    pub by_pose_line: Option<f64>,
     /// The plan ends on another equilibrium of the goal pose than its static solve's, which
     /// the gripper's motion reached (`PlanResult::reached_goal`).
     pub reached_goal: bool,
@@ -520,19 +523,18 @@ pub fn run(
     let seconds = t0.elapsed().as_secs_f64();
     let planned = r.status == PlanStatus::Planned;
     let executed = r.executed_path();
-    // The report's replay is the straight-line path's where the plan follows its trajectory.
-    let along_straight = r
-        .equilibrium_plan
-        .as_ref()
-        .is_some_and(|e| e.trajectory == "straight_path");
+    // The report's replay is the straight-line path's where the plan follows its trajectory,
+    // the pose line's along one.
+    let along_straight = r.along_straight_trajectory();
     let t = &r.trajectory;
     Some(Outcome {
         name: name.to_string(),
         planned,
-        coincide: planned && r.replay.coincide && !along_straight,
+        coincide: planned && r.replay.coincide && !r.along_other_trajectory(),
         executable: executed.is_some(),
         by_equilibria: executed == Some("equilibria"),
         by_straight: executed.is_some() && along_straight,
+        by_pose_line: r.along_pose_line().filter(|_| executed.is_some()),
         reached_goal: r.reached_goal.is_some(),
         reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned()),
         why_not: executed.is_none().then(|| {
@@ -596,6 +598,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let executable = out.iter().filter(|o| o.executable).count();
     let by_equilibria = out.iter().filter(|o| o.by_equilibria).count();
     let by_straight = out.iter().filter(|o| o.by_straight).count();
+    let by_line = out.iter().filter(|o| o.by_pose_line.is_some()).count();
     let reached = out.iter().filter(|o| o.reached_goal).count();
     let snaps = out.iter().filter(|o| o.snaps).count();
     let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
@@ -606,7 +609,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
-        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path; {reached} to a reached goal) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path, {by_line} along a pose line; {reached} to a reached goal) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
         pct(planned),
         pct(coincide),
         pct(executable),
@@ -783,6 +786,12 @@ fn main() {
                             o.replay.2,
                             o.attempts
                         );
+                        if let Some(h) = o.by_pose_line {
+                            eprintln!(
+                                "{:16} executable along a line in the end's pose space lifted {h} L",
+                                o.name
+                            );
+                        }
                         if o.reached_not_replanned {
                             eprintln!(
                                 "{:16} executable by its first plan's equilibria, which end on another equilibrium of the goal pose",

@@ -179,14 +179,23 @@ impl EndPose {
     /// The full pose of shape `a` at `s = L`: every position component and every angle field
     /// of the layout.
     pub fn of(model: &Model, a: &[f64], positions: &[[f64; 3]]) -> EndPose {
-        let b = model.boundary(1.0);
+        EndPose::at(
+            model,
+            positions[model.boundary(1.0)],
+            model.angles_at(a, 1.0),
+        )
+    }
+
+    /// The pose of the end at `position` (units of L) with Euler angles `angles` (`θ` alone
+    /// read on a planar rod): the layout's position components and angle fields.
+    pub fn at(model: &Model, position: [f64; 3], angles: [f64; 3]) -> EndPose {
         let position = model
             .layout
             .components()
             .iter()
-            .map(|&k| (k, positions[b][k]))
+            .map(|&k| (k, position[k]))
             .collect();
-        let [phi, theta, psi] = model.angles_at(a, 1.0);
+        let [phi, theta, psi] = angles;
         let angles = if model.layout.spatial {
             if theta.sin().abs() < GIMBAL {
                 vec![

@@ -21,7 +21,7 @@
 use super::Planner;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
-use super::replay::{EarlyStop, Replay, ReplayOptions, max_distance, replay};
+use super::replay::{EarlyStop, Replay, ReplayOptions, max_distance, replay_driven};
 use crate::constraints::Constraint;
 use crate::rod::model::Model;
 use crate::statics::StaticProblem;
@@ -70,11 +70,15 @@ pub struct EquilibriumPlan {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_samples: Option<usize>,
     /// Whose end poses the gripper follows: `"optimal_path"` (the optimal path's, as the
-    /// replay) or `"straight_path"` (the straight-line path's, tried when no optimised path is
-    /// executable, neither as it stands nor by its equilibria).
+    /// replay), `"straight_path"` (the straight-line path's, tried when no optimised path is
+    /// executable, neither as it stands nor by its equilibria) or `"pose_line"` (a line in the
+    /// end's pose space, [`super::pose_line`], tried when neither of those executes).
     pub trajectory: &'static str,
-    /// Along the straight-line path's trajectory: why the optimal path was not executable, as
-    /// it stands or by its equilibria (`None` otherwise).
+    /// Along a pose line: how far it lifts the end mid-way against gravity (units of L).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lift_over_l: Option<f64>,
+    /// Along another trajectory than the optimal path's: why the optimal path was not
+    /// executable, as it stands or by its equilibria (`None` otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal_path_not_executable: Option<String>,
     /// The shapes dip into an obstacle between the solves' contact points.
@@ -305,6 +309,7 @@ impl Planner {
             contact_margin: None,
             contact_samples: None,
             trajectory: "optimal_path",
+            lift_over_l: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goal: None,
@@ -340,11 +345,12 @@ impl Planner {
             early_stop: EarlyStop::Unconverged,
             ..self.settings.replay()
         };
-        let second = replay(
+        let second = replay_driven(
             base,
             &self.start,
             path,
             z,
+            self.drive.as_deref(),
             opts,
             &self.static_options,
             &mut StopOnly(observer),

@@ -5,7 +5,7 @@
 use super::equilibrium_plan;
 use super::observer::{PlanObserver, RecordedShapes, Recorder};
 use super::path::DeformationPath;
-use super::replay::{self, EarlyStop, Replay, ReplayOptions, replay};
+use super::replay::{self, EarlyStop, Replay, ReplayOptions, replay_driven};
 use super::result;
 use super::starts::StartPlan;
 use super::{HOLD_OFF_ROUNDS, Planner, hold_off_margin};
@@ -100,11 +100,12 @@ impl Planner {
         early_stop: EarlyStop,
         observer: &mut dyn PlanObserver,
     ) -> Replay {
-        replay(
+        replay_driven(
             base,
             &self.start,
             path,
             z,
+            self.drive.as_deref(),
             ReplayOptions {
                 early_stop,
                 ..self.settings.replay()

@@ -14,6 +14,7 @@ pub mod minimax;
 pub mod observer;
 pub mod orientation;
 pub mod path;
+pub mod pose_line;
 mod reached_goal;
 pub mod replay;
 pub mod result;
@@ -199,6 +200,9 @@ pub struct Planner {
     /// again where the gripper's motion reaches that equilibrium and no plan to it executes
     /// ([`PlanSettings::reached_goal`]).
     ends_on: Option<Arc<Vec<[f64; 3]>>>,
+    /// The pose line the replays hold the end on instead of the end poses of the path they
+    /// replay: set on the copy that judges the equilibria along it ([`pose_line`]).
+    drive: Option<Arc<pose_line::PoseLine>>,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
@@ -430,6 +434,7 @@ impl Planner {
             quick: false,
             goal_by_pose: problem.goal.is_pose() && problem.goal.shape.is_none(),
             ends_on: None,
+            drive: None,
             finer_retry: false,
             workers: workers::Workers::new(settings.threads()),
             end_grid: Arc::new((verify_s, fine)),
@@ -611,9 +616,9 @@ impl Planner {
         }
     }
 
-    /// How far the controlled end of `path(z)` leaves the workspace on the verification grid
-    /// in k (case units), where, and whether within the collision tolerance: `None` without a
-    /// workspace.
+    /// How far the controlled end of `path(z)` (of the pose line this planner drives the end
+    /// on, if any) leaves the workspace on the verification grid in k (case units), where, and
+    /// whether within the collision tolerance: `None` without a workspace.
     pub fn workspace_check(
         &self,
         path: &DeformationPath,
@@ -628,9 +633,15 @@ impl Planner {
         let mut worst = (0.0, 0.0);
         for j in 0..nk {
             let k = j as f64 / (nk - 1) as f64;
-            path.shape_at(z, k, &mut a);
-            model.evaluate_into(&a, &mut shape);
-            let e = w.excess(shape.positions[b].map(|v| v * l));
+            let x = match &self.drive {
+                Some(line) => line.position(k),
+                None => {
+                    path.shape_at(z, k, &mut a);
+                    model.evaluate_into(&a, &mut shape);
+                    shape.positions[b]
+                }
+            };
+            let e = w.excess(x.map(|v| v * l));
             if e > worst.0 {
                 worst = (e, k);
             }

@@ -9,6 +9,7 @@
 
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
+use super::pose_line::PoseLine;
 use crate::planner::path::DeformationPath;
 use crate::planner::workers::{JOB_EQUILIBRIA, Workers};
 use crate::rod::kinematics::Shape;
@@ -168,20 +169,19 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
     l
 }
 
-/// The static shape of `base` held at the end pose of coefficients `a` (with boundary
-/// `positions`), solved from `from`'s shape and multipliers; the problem is returned with it.
+/// The static shape of `base` held at end pose `pose`, solved from `from`'s shape and
+/// multipliers; the problem is returned with it.
 /// With `stiff_retry` (the replay's steps), a solve that does not converge runs once more from
 /// the same start with a hundred times the starting penalty. The tracking rounds' marches do
 /// without: their equilibria are targets, and the optimiser's path follows them.
 fn solve_held(
     base: &StaticProblem,
     from: &StaticSolution,
-    a: &[f64],
-    positions: &[[f64; 3]],
+    pose: &EndPose,
     opts: &StaticOptions,
     stiff_retry: bool,
 ) -> (StaticProblem, StaticSolution) {
-    let mut p = EndPose::of(&base.model, a, positions).problem(base);
+    let mut p = pose.problem(base);
     let lambda = warm_multipliers(base, from, &p);
     let sol = solve_static_warm(&mut p, &from.a, &lambda, opts);
     if sol.status == SolveStatus::Converged || !stiff_retry {
@@ -213,7 +213,8 @@ pub(super) fn start_under(
         lambda: Vec::new(),
         ..start.clone()
     };
-    let (_, sol) = solve_held(base, &from, &start.a, &positions, opts, true);
+    let pose = EndPose::of(&base.model, &start.a, &positions);
+    let (_, sol) = solve_held(base, &from, &pose, opts, true);
     (sol.status == SolveStatus::Converged).then_some(sol)
 }
 
@@ -263,6 +264,34 @@ pub fn replay(
     observer: &mut dyn PlanObserver,
     stop: &AtomicBool,
 ) -> Replay {
+    replay_driven(
+        base,
+        start,
+        path,
+        z,
+        None,
+        opts,
+        static_opts,
+        observer,
+        stop,
+    )
+}
+
+/// [`replay`] with the end held at the poses of `drive` where it is given (the shapes of
+/// `path(z)` are then the reference the replayed ones are compared with), at the end poses of
+/// `path(z)`'s shapes otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn replay_driven(
+    base: &StaticProblem,
+    start: &StaticSolution,
+    path: &DeformationPath,
+    z: &[f64],
+    drive: Option<&PoseLine>,
+    opts: ReplayOptions,
+    static_opts: &StaticOptions,
+    observer: &mut dyn PlanObserver,
+    stop: &AtomicBool,
+) -> Replay {
     let model = &base.model;
     let l = model.rod.length;
     let unit = model.rod.energy_unit();
@@ -276,7 +305,11 @@ pub fn replay(
         (a.clone(), shape.positions.clone(), u)
     };
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
-        let (mut p, mut sol) = solve_held(base, &from.sol, &target.0, &target.1, static_opts, true);
+        let pose = match drive {
+            Some(line) => line.end_pose(model, k),
+            None => EndPose::of(model, &target.0, &target.1),
+        };
+        let (mut p, mut sol) = solve_held(base, &from.sol, &pose, static_opts, true);
         // A solve that ran out of iterations gets one more budget from where it stopped.
         if sol.status == SolveStatus::IterationLimit {
             sol = solve_static_warm(&mut p, &sol.a, &sol.lambda, static_opts);
@@ -518,7 +551,8 @@ fn march(
         path.shape_at(z, k, &mut a);
         model.evaluate_into(&a, &mut shape);
         let from = out.last().map_or(first, |(_, sol)| sol);
-        let (_, sol) = solve_held(base, from, &a, &shape.positions, opts, false);
+        let pose = EndPose::of(model, &a, &shape.positions);
+        let (_, sol) = solve_held(base, from, &pose, opts, false);
         out.push((model.evaluate(&sol.a).positions, sol));
     }
     out

@@ -307,16 +307,16 @@ impl ReachedGoal {
 impl PlanResult {
     /// What the gripper trajectory executes: `"optimal"`, the optimal path itself (collision-free,
     /// converged, and its replay coincides), else `"equilibria"`, the replayed equilibria along
-    /// its trajectory, or along the straight-line path's when no optimised path executes
-    /// (`equilibrium_plan.trajectory`; see [`super::equilibrium_plan`]), else nothing.
+    /// its trajectory, or along the straight-line path's or a pose line when no optimised path
+    /// executes (`equilibrium_plan.trajectory`; see [`super::equilibrium_plan`]), else nothing.
     pub fn executed_path(&self) -> Option<&'static str> {
         if self.workspace.as_ref().is_some_and(|w| !w.within) {
             return None;
         }
-        // Along the straight-line path's trajectory, the replay is that path's.
+        // Along another trajectory, the replay is that trajectory's.
         if self.status == PlanStatus::Planned
             && self.replay.coincide
-            && !self.along_straight_trajectory()
+            && !self.along_other_trajectory()
         {
             Some("optimal")
         } else if self.equilibrium_plan.as_ref().is_some_and(|e| e.executable) {
@@ -332,6 +332,23 @@ impl PlanResult {
         self.equilibrium_plan
             .as_ref()
             .is_some_and(|e| e.trajectory == "straight_path")
+    }
+
+    /// Whether the replayed equilibria judged as the plan follow a pose line
+    /// (`equilibrium_plan.trajectory` is `"pose_line"`, [`super::pose_line`]): the lift, if so.
+    pub fn along_pose_line(&self) -> Option<f64> {
+        self.equilibrium_plan
+            .as_ref()
+            .filter(|e| e.trajectory == "pose_line")
+            .and_then(|e| e.lift_over_l)
+    }
+
+    /// Whether the replay is not the optimal path's: it followed the straight-line path's end
+    /// poses or a pose line.
+    pub fn along_other_trajectory(&self) -> bool {
+        self.equilibrium_plan
+            .as_ref()
+            .is_some_and(|e| e.trajectory != "optimal_path")
     }
 
     /// The verdict: executable, or why not.

@@ -8,7 +8,7 @@ use super::result::{Attempt, PlanResult, PlanStatus, StartSummary, Timing};
 use super::start::{self, Verified};
 use super::starts::StartPlan;
 use super::verify::fine_model;
-use super::{Planner, clearance, trajectory};
+use super::{Planner, clearance, pose_line, trajectory};
 use crate::optim::AlStatus;
 use crate::rod::kinematics::Shape;
 use std::sync::Arc;
@@ -182,8 +182,8 @@ impl Planner {
         // else the starts.
         let ends = self.end_clearances();
         let end_inside = self.end_inside_obstacle(&ends);
-        // The plan is the equilibria along the straight path's trajectory.
-        let mut along_straight = false;
+        // The plan is the equilibria along the straight path's trajectory or a pose line.
+        let mut along_other = false;
         let (runs, best, mut judged) = if end_inside.is_some() {
             (
                 Vec::new(),
@@ -195,7 +195,7 @@ impl Planner {
                 Some(j) => (Vec::new(), None, j),
                 None => match self.straight_trajectory_plan(&straight, &ends, &fine, observer) {
                     Some(j) => {
-                        along_straight = true;
+                        along_other = true;
                         (Vec::new(), None, j)
                     }
                     None => {
@@ -232,37 +232,64 @@ impl Planner {
             && self.settings.equilibrium_plans
             && !self.stopped()
         {
-            let mut s = self.judge_straight_trajectory(&fine, observer);
+            let why = judged
+                .equilibrium_plan
+                .as_ref()
+                .and_then(|e| e.reason.clone())
+                .unwrap_or_else(|| {
+                    if judged.workspace.as_ref().is_some_and(|w| !w.within) {
+                        "its end leaves the workspace".into()
+                    } else {
+                        "not executable".into()
+                    }
+                });
+            // The straight-line path's trajectory, then the pose lines in increasing lift; the
+            // first whose equilibria pass is the plan.
+            let mut found = None;
+            let mut failed: Vec<(String, Judged)> = Vec::new();
+            let s = self.judge_straight_trajectory(&fine, observer);
             if s.executable {
-                let why = judged
-                    .equilibrium_plan
-                    .as_ref()
-                    .and_then(|e| e.reason.clone())
-                    .unwrap_or_else(|| {
-                        if judged.workspace.as_ref().is_some_and(|w| !w.within) {
-                            "its end leaves the workspace".into()
-                        } else {
-                            "not executable".into()
-                        }
-                    });
+                found = Some(s);
+            } else {
+                failed.push(("along the straight path's trajectory".into(), s));
+                for lift in pose_line::LIFTS {
+                    if !self.settings.pose_lines || self.stopped() || self.time_up() {
+                        break;
+                    }
+                    let s = self.judge_pose_line(lift, &fine, observer);
+                    if s.executable {
+                        found = Some(s);
+                        break;
+                    }
+                    let what = if lift > 0.0 {
+                        format!("along the end's pose line lifted {lift} L")
+                    } else {
+                        "along the end's pose line".into()
+                    };
+                    failed.push((what, s));
+                }
+            }
+            if let Some(mut s) = found {
                 if let Some(e) = s.equilibrium_plan.as_mut() {
                     e.optimal_path_not_executable = Some(why);
                 }
                 judged = s;
-                along_straight = true;
-            } else if let (Some(e), Some(s)) =
-                (judged.equilibrium_plan.as_mut(), &s.equilibrium_plan)
-            {
-                e.retry_failed_as("along the straight path's trajectory", s);
+                along_other = true;
+            } else if let Some(e) = judged.equilibrium_plan.as_mut() {
+                for (what, s) in &failed {
+                    if let Some(f) = &s.equilibrium_plan {
+                        e.retry_failed_as(what, f);
+                    }
+                }
             }
         }
         let t_plan = t0.elapsed().as_secs_f64() - judged.seconds;
 
         observer.phase("replay");
-        // Along the straight path, the replay recorded the straight path's shapes as its
-        // optimal ones (logged as the straight path's already): the log's optimal path is the
-        // optimiser's.
-        if along_straight {
+        // Along the straight path or a pose line, the replay recorded the straight path's shapes
+        // as its optimal ones (logged as the straight path's already): the log's optimal path is
+        // the optimiser's.
+        if along_other {
             let mut a = vec![0.0; path.n()];
             let mut sh = Shape::default();
             judged.shapes.set_optimal(|k| {
@@ -277,12 +304,22 @@ impl Planner {
         let ks: Vec<f64> = rep.steps.iter().map(|s| s.k).collect();
         let straight_path = self.path();
         let straight_z = vec![0.0; straight_path.n_vars()];
-        let (traj_path, traj_z) = if along_straight {
+        let (traj_path, traj_z) = if along_other {
             (&straight_path, &straight_z)
         } else {
             (&path, &chosen.z)
         };
-        let trajectory = trajectory::Trajectory::along(model, traj_path, traj_z, &ks);
+        // Along a pose line, the end poses of the replayed equilibria, which hold them.
+        let along_line = equilibrium_plan
+            .as_ref()
+            .is_some_and(|e| e.trajectory == "pose_line");
+        let trajectory = if along_line {
+            let shapes: Vec<(f64, Vec<f64>)> =
+                rep.steps.iter().map(|s| (s.k, s.a.clone())).collect();
+            trajectory::Trajectory::of_shapes(model, &self.start.a, &shapes)
+        } else {
+            trajectory::Trajectory::along(model, traj_path, traj_z, &ks)
+        };
         // Judged with the replay; a run stopped before it is checked here.
         let workspace = judged_workspace.or_else(|| self.workspace_check(traj_path, traj_z));
         let status = if interrupted {

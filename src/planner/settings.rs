@@ -120,6 +120,10 @@ pub struct PlanSettings {
     /// equilibrium, and report the plan to it where it is executable
     /// ([`super::PlanResult::reached_goal`]); `false`: only the end solve's goal shape.
     pub reached_goal: bool,
+    /// Where neither an optimised path nor the straight-line path executes by its replayed
+    /// equilibria, try the equilibria along lines in the end's pose space, lifted against
+    /// gravity by 0, 0.15, 0.3 and 0.5 L mid-way ([`super::pose_line`]); `false`: not.
+    pub pose_lines: bool,
     /// Lift a converged plan that is collision-free but not executable — the quick attempt's
     /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the
     /// first fallback count's path terms and run equilibrium tracking on it again
@@ -202,6 +206,7 @@ impl Default for PlanSettings {
             quick_attempt: true,
             least_energy_ends: false,
             reached_goal: true,
+            pose_lines: true,
             lift: true,
             time_limit: None,
         }

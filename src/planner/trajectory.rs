@@ -207,16 +207,26 @@ impl Trajectory {
     /// The trajectory of the controlled end along `path(z)` at the path parameters `ks`
     /// (increasing; the replay's steps), with the held end's pose from the path's start.
     pub fn along(model: &Model, path: &DeformationPath, z: &[f64], ks: &[f64]) -> Trajectory {
-        let mut a = vec![0.0; path.n()];
-        let mut shape = Shape::default();
-        path.shape_at(z, 0.0, &mut a);
-        model.evaluate_into(&a, &mut shape);
-        let held = pose_at(model, &a, &shape, 0.0, 0.0);
-        let mut poses: Vec<GripperPose> = Vec::with_capacity(ks.len());
-        for &k in ks {
+        let shapes = std::iter::once(0.0).chain(ks.iter().copied()).map(|k| {
+            let mut a = vec![0.0; path.n()];
             path.shape_at(z, k, &mut a);
-            model.evaluate_into(&a, &mut shape);
-            let mut p = pose_at(model, &a, &shape, 1.0, k);
+            (k, a)
+        });
+        let mut shapes: Vec<(f64, Vec<f64>)> = shapes.collect();
+        let first = shapes.remove(0).1;
+        Self::of_shapes(model, &first, &shapes)
+    }
+
+    /// The trajectory of the controlled end of the shapes `(k, a)` (increasing `k`), with the
+    /// held end's pose from shape `first`.
+    pub fn of_shapes(model: &Model, first: &[f64], shapes: &[(f64, Vec<f64>)]) -> Trajectory {
+        let mut shape = Shape::default();
+        model.evaluate_into(first, &mut shape);
+        let held = pose_at(model, first, &shape, 0.0, 0.0);
+        let mut poses: Vec<GripperPose> = Vec::with_capacity(shapes.len());
+        for (k, a) in shapes {
+            model.evaluate_into(a, &mut shape);
+            let mut p = pose_at(model, a, &shape, 1.0, *k);
             // Keep the quaternion in the previous one's hemisphere: q and −q are the same
             // rotation, and a controller interpolating between them would turn the long way.
             if let Some(prev) = poses.last() {

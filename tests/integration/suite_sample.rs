@@ -1636,7 +1636,8 @@ fn holds_the_goals_end_pose(p: &dlo_planner::planner::Planner, a: &[f64]) {
 /// A goal pose reached by the first plan's replayed equilibria, on another equilibrium of the
 /// pose than its static solve's, where the plan made again to that equilibrium does not
 /// execute: those equilibria are the plan (`table_2_1` of the table family, a heavy cable
-/// dragged across a table). Every check of replayed equilibria holds (held at the
+/// dragged across a table, planned without the pose lines, `"pose_lines": false`: with them
+/// the line lifted 0.5 L is its plan, ending on the goal shape). Every check of replayed equilibria holds (held at the
 /// trajectory's poses, converged, stable, clear of the obstacles on a grid four times
 /// finer in s, confirmed on twice the steps), they end on the reached equilibrium, which holds
 /// the goal's end pose and lies beyond the coincidence tolerance from the goal shape, and the
@@ -1649,7 +1650,10 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
         planned_with(&text, "table_2_1.json", &fields, ends)
     };
     let mut ends = Logged::default();
-    let (p, r) = plan(serde_json::json!({}), &mut ends);
+    let (p, r) = plan(
+        serde_json::json!({"plan": {"pose_lines": false}}),
+        &mut ends,
+    );
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
     let g = r.reached_goal.as_ref().expect("a reached goal");
@@ -1679,8 +1683,78 @@ fn a_goal_pose_reached_by_the_first_plans_equilibria_ends_the_plan_there() {
     path.shape_at(&r.z, 1.0, &mut end);
     assert_eq!(end, p.goal.a);
     let (_, off) = plan(
-        serde_json::json!({"plan": {"reached_goal": false}}),
+        serde_json::json!({"plan": {"reached_goal": false, "pose_lines": false}}),
         &mut Logged::default(),
     );
     fails_for_another_equilibrium(&off);
+}
+
+/// `table_1_4` of the table family: a heavy cable (weight 14 per length) clamped above a table
+/// with a cup on it, its end moved across the table. The equilibria along the optimal path's
+/// end poses and along the straight-line path's stop converging where those poses press the
+/// cable into the table; along the line in the end's pose space lifted 0.5 L mid-way they are
+/// the plan (the lower lifts snap or end on another equilibrium of the goal pose). Checked
+/// independently of the planner's line: every replayed equilibrium holds its end at the chord
+/// between the start's and the goal's end positions raised by `0.5 L · 4k(1 − k)` along x
+/// (against gravity), with its end frame the shortest rotation's between theirs (a slerp), to
+/// 1e-9; the equilibria are converged, stable, clear of the table and the cup on a grid four
+/// times finer in s, and end on the goal shape. With `"pose_lines": false` no plan executes.
+#[test]
+fn a_heavy_cable_dragged_across_a_table_follows_a_lifted_pose_line() {
+    use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+    let text = nth_problem(table_problem, 1, 4);
+    let (p, r) = planned_with(
+        &text,
+        "table_1_4.json",
+        &serde_json::json!({}),
+        &mut Logged::default(),
+    );
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    assert_eq!(r.along_pose_line(), Some(0.5));
+    let e = r.equilibrium_plan.as_ref().expect("judged equilibria");
+    let why = e.optimal_path_not_executable.as_deref().unwrap_or_default();
+    assert!(why.contains("did not converge"), "{why}");
+    assert!(
+        e.confirmation_deviation_over_l
+            .is_some_and(|d| d <= r.replay.tolerance)
+    );
+    let model = &p.base.model;
+    let tip = model.boundary(1.0);
+    let (x0, x1) = (
+        model.evaluate(&p.start.a).positions[tip],
+        model.evaluate(&p.goal.a).positions[tip],
+    );
+    let q = |a: &[f64]| {
+        let m = model.frame_at(a, 1.0);
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(Matrix3::from_fn(
+            |i, j| m[i][j],
+        )))
+    };
+    let (q0, q1) = (q(&p.start.a), q(&p.goal.a));
+    for step in &r.replay.steps {
+        let k = step.k;
+        let end = step.positions[tip];
+        for i in 0..3 {
+            let lift = if i == 0 {
+                0.5 * 4.0 * k * (1.0 - k)
+            } else {
+                0.0
+            };
+            let want = (1.0 - k) * x0[i] + k * x1[i] + lift;
+            assert!((end[i] - want).abs() <= 1e-9, "k = {k}: {end:?}");
+        }
+        let turn = q0.slerp(&q1, k).angle_to(&q(&step.a));
+        assert!(turn <= 1e-9, "k = {k}: {turn} rad from the slerp's frame");
+    }
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
+    // Without the lines, no plan executes.
+    let (_, off) = planned_with(
+        &text,
+        "table_1_4.json",
+        &serde_json::json!({"plan": {"pose_lines": false}}),
+        &mut Logged::default(),
+    );
+    assert!(!off.verdict().is_executable(), "{}", off.verdict());
+    assert_eq!(off.along_pose_line(), None);
 }

@@ -452,13 +452,22 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         "case {}: {}{} ({}; {})",
         r.case,
         r.verdict,
-        match r.executed_path {
-            Some("equilibria") if p.along_straight_trajectory() =>
-                " by the replayed equilibria along the straight-line path's trajectory",
-            Some("equilibria") => " by the replayed equilibria along the optimal path's trajectory",
-            Some(_) if p.straight_path_plan => " along the straight-line path",
-            Some(_) => " as optimised",
-            None => "",
+        match (r.executed_path, p.along_pose_line()) {
+            (Some("equilibria"), _) if p.along_straight_trajectory() =>
+                " by the replayed equilibria along the straight-line path's trajectory".into(),
+            (Some("equilibria"), Some(h)) => format!(
+                " by the replayed equilibria along a line in the end's pose space{}",
+                if h > 0.0 {
+                    format!(" lifted {h} L mid-way")
+                } else {
+                    String::new()
+                }
+            ),
+            (Some("equilibria"), None) =>
+                " by the replayed equilibria along the optimal path's trajectory".into(),
+            (Some(_), _) if p.straight_path_plan => " along the straight-line path".into(),
+            (Some(_), _) => " as optimised".into(),
+            (None, _) => String::new(),
         },
         p.status,
         match (p.optimiser, &p.end_inside_obstacle) {
@@ -638,9 +647,16 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     }
     if let Some(e) = &p.equilibrium_plan {
         if let Some(why) = &e.optimal_path_not_executable {
+            let follows = match e.lift_over_l {
+                Some(h) if h > 0.0 => format!(
+                    "a line in its pose space, lifted {h} L mid-way against gravity; the replay is that line's"
+                ),
+                Some(_) => "a line in its pose space; the replay is that line's".into(),
+                None => "the straight-line path's end poses".into(),
+            };
             let _ = writeln!(
                 o,
-                "  the optimal path is not executable ({why}); the gripper follows the straight-line path's end poses"
+                "  the optimal path is not executable ({why}); the gripper follows {follows}"
             );
         }
         let _ = writeln!(

@@ -1,0 +1,189 @@
+//! The controlled end driven along a line in its own pose space, every shape the equilibrium
+//! its pose produces: a plan made for the gripper directly, tried where neither the optimal
+//! path's end poses nor the straight-line path's execute.
+//!
+//! The coefficient-space paths (the optimal path, paper §7, and the straight one) move the
+//! end as their shapes do, and the end poses of a heavy cable's shapes can press it into a
+//! table it rests on, or turn the end the long way round. A pose line moves the end's
+//! position along the straight line from the start's to the goal's, raised against gravity by
+//! `lift · 4k(1 − k)` (units of L: the highest mid-way), and turns its frame along the
+//! shortest rotation between the two (a slerp), its Euler angles continued from the start's.
+//! Lifted, the cable hangs clear of what it would be dragged over, instead of snapping across
+//! it. The replayed equilibria along it are judged exactly as those along the other
+//! trajectories ([`super::equilibrium_plan`]); the lifts are tried in increasing order, and the
+//! first that passes is the plan.
+
+use super::Planner;
+use super::endpoints::EndPose;
+use super::judge::Judged;
+use super::observer::PlanObserver;
+use super::replay::EarlyStop;
+use crate::rod::model::Model;
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+use std::sync::Arc;
+
+/// Lifts of the pose lines tried, in order (units of L).
+pub const LIFTS: [f64; 4] = [0.0, 0.15, 0.3, 0.5];
+
+/// Steps of `k` on which the Euler angles are continued from the start's.
+const TURN_STEPS: usize = 1024;
+
+/// A line in the controlled end's pose space (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct PoseLine {
+    /// Start and goal positions of the end (units of L, the rod's position frame).
+    from: [f64; 3],
+    to: [f64; 3],
+    /// The lift mid-way (units of L, against gravity).
+    lift: [f64; 3],
+    /// How far it is lifted (units of L).
+    pub lift_over_l: f64,
+    turn: Turn,
+}
+
+#[derive(Clone, Debug)]
+enum Turn {
+    /// A planar rod's `θ`, linear from the start's to the goal's.
+    Planar(f64, f64),
+    /// The shortest rotation between two frames, with its Euler angles at `k = i / TURN_STEPS`
+    /// continued from the start's.
+    Spatial {
+        from: UnitQuaternion<f64>,
+        to: UnitQuaternion<f64>,
+        angles: Vec<[f64; 3]>,
+    },
+}
+
+fn quaternion(m: [[f64; 3]; 3]) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(Matrix3::from_fn(
+        |i, j| m[i][j],
+    )))
+}
+
+fn matrix(q: &UnitQuaternion<f64>) -> [[f64; 3]; 3] {
+    let r = q.to_rotation_matrix();
+    std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
+}
+
+impl PoseLine {
+    /// The line from the end pose of shape `start` to that of shape `goal`, lifted by `lift`
+    /// (units of L) against gravity (along `x`, the vertical, in the rod's frame).
+    pub fn new(model: &Model, start: &[f64], goal: &[f64], lift: f64) -> PoseLine {
+        let b = model.boundary(1.0);
+        let from = model.evaluate(start).positions[b];
+        let to = model.evaluate(goal).positions[b];
+        let up = model.up().unwrap_or([1.0, 0.0, 0.0]);
+        let (e0, e1) = (model.angles_at(start, 1.0), model.angles_at(goal, 1.0));
+        let turn = if model.layout.spatial {
+            let r = |e: [f64; 3]| quaternion(crate::rod::kinematics::rotation(e[0], e[1], e[2]));
+            let (q0, q1) = (r(e0), r(e1));
+            let mut angles = Vec::with_capacity(TURN_STEPS + 1);
+            angles.push(e0);
+            for i in 1..=TURN_STEPS {
+                let k = i as f64 / TURN_STEPS as f64;
+                let prev = angles[i - 1];
+                angles.push(super::orientation::euler_branch(
+                    matrix(&q0.slerp(&q1, k)),
+                    prev,
+                    None,
+                ));
+            }
+            Turn::Spatial {
+                from: q0,
+                to: q1,
+                angles,
+            }
+        } else {
+            Turn::Planar(e0[1], e1[1])
+        };
+        PoseLine {
+            from,
+            to,
+            lift: up.map(|u| u * lift),
+            lift_over_l: lift,
+            turn,
+        }
+    }
+
+    /// The end's position at `k` (units of L).
+    pub fn position(&self, k: f64) -> [f64; 3] {
+        let h = 4.0 * k * (1.0 - k);
+        std::array::from_fn(|i| (1.0 - k) * self.from[i] + k * self.to[i] + h * self.lift[i])
+    }
+
+    /// The end's Euler angles at `k` (`[0, θ, 0]` on a planar rod).
+    pub fn angles(&self, k: f64) -> [f64; 3] {
+        match &self.turn {
+            Turn::Planar(t0, t1) => [0.0, (1.0 - k) * t0 + k * t1, 0.0],
+            Turn::Spatial { from, to, angles } => {
+                let k = k.clamp(0.0, 1.0);
+                let i = ((k * TURN_STEPS as f64).floor() as usize).min(TURN_STEPS);
+                if (i as f64 / TURN_STEPS as f64) == k {
+                    return angles[i];
+                }
+                super::orientation::euler_branch(matrix(&from.slerp(to, k)), angles[i], None)
+            }
+        }
+    }
+
+    /// The end pose at `k`, as a replay holds it.
+    pub fn end_pose(&self, model: &Model, k: f64) -> EndPose {
+        EndPose::at(model, self.position(k), self.angles(k))
+    }
+}
+
+impl Planner {
+    /// The replayed equilibria along the pose line lifted by `lift` (units of L), judged as a
+    /// plan on the verification model `fine` ([`Self::judge_path`], with the straight-line
+    /// path's shapes as the replay's reference).
+    pub(super) fn judge_pose_line(
+        &self,
+        lift: f64,
+        fine: &Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let model = &self.base.model;
+        let driven = Planner {
+            drive: Some(Arc::new(PoseLine::new(
+                model,
+                &self.start.a,
+                &self.goal.a,
+                lift,
+            ))),
+            ..self.clone()
+        };
+        let path = self.path();
+        let z = vec![0.0; path.n_vars()];
+        let mut judged =
+            driven.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        if let Some(e) = judged.equilibrium_plan.as_mut() {
+            e.trajectory = "pose_line";
+            e.lift_over_l = Some(lift);
+        }
+        judged
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PoseLine;
+
+    /// The line starts and ends on the end poses of its shapes (angles as the shapes have
+    /// them), rises by the lift mid-way, and turns along the shortest rotation: its frames at
+    /// `k` and the slerp's agree.
+    #[test]
+    fn a_pose_line_joins_the_end_poses_and_turns_the_short_way() {
+        let p = super::super::paper_planner();
+        let model = &p.base.model;
+        let line = PoseLine::new(model, &p.start.a, &p.goal.a, 0.3);
+        let b = model.boundary(1.0);
+        for (k, a) in [(0.0, &p.start.a), (1.0, &p.goal.a)] {
+            let x = model.evaluate(a).positions[b];
+            let y = line.position(k);
+            assert!((0..3).all(|i| (x[i] - y[i]).abs() < 1e-15));
+            assert!((line.angles(k)[1] - model.angles_at(a, 1.0)[1]).abs() < 1e-15);
+        }
+        let (x0, x1, xm) = (line.position(0.0), line.position(1.0), line.position(0.5));
+        assert!((xm[0] - (0.5 * (x0[0] + x1[0]) + 0.3)).abs() < 1e-15);
+    }
+}
