@@ -186,4 +186,53 @@ mod tests {
         let (x0, x1, xm) = (line.position(0.0), line.position(1.0), line.position(0.5));
         assert!((xm[0] - (0.5 * (x0[0] + x1[0]) + 0.3)).abs() < 1e-15);
     }
+
+    /// A 3D end turned from a frame tilted 0.3 rad towards −y to one tilted 0.06 rad towards
+    /// +y (φ from −π/2 to π/2, as the end rows of a cable moved across a table hold them):
+    /// at every `k` the frame of the line's Euler angles is the slerp's, the angles stay on one
+    /// branch, they start on the start shape's own, and near θ = 0 the end pose holds `θ` and
+    /// `φ + ψ` only.
+    #[test]
+    fn a_spatial_pose_line_turns_along_the_slerp_with_continuous_angles() {
+        use crate::rod::Rod;
+        use crate::rod::kinematics::rotation;
+        use crate::rod::layout::Layout;
+        use crate::rod::model::{Discretisation, Model};
+        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
+        let layout = Layout::of(&rod, 4);
+        let d = Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        };
+        let model = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let a0 = vec![0.0; model.n()];
+        let half = std::f64::consts::FRAC_PI_2;
+        let (e0, e1) = ([-half, 0.3, 1.5], [half, 0.06, -1.6]);
+        let start = super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e0);
+        let goal = super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e1);
+        let line = PoseLine::new(&model, &start, &goal, 0.0);
+        let m = |e: [f64; 3]| super::quaternion(rotation(e[0], e[1], e[2]));
+        let (q0, q1) = (m(e0), m(e1));
+        assert_eq!(line.angles(0.0), model.angles_at(&start, 1.0));
+        let mut prev = line.angles(0.0);
+        for i in 1..=2000 {
+            let k = i as f64 / 2000.0;
+            let e = line.angles(k);
+            // (Near the pole the angles give the frame back to about 1e-12 rad.)
+            let off = q0.slerp(&q1, k).angle_to(&m(e));
+            assert!(off < 1e-10, "k = {k}: {off:e} rad");
+            // θ and φ + ψ move little; φ alone swings fast where the turn passes near the
+            // pole (θ ≈ 0.002 here), but never jumps to another branch.
+            let (dt, ds) = (
+                (e[1] - prev[1]).abs(),
+                (e[0] + e[2] - prev[0] - prev[2]).abs(),
+            );
+            assert!(dt < 1e-3 && ds < 1e-2, "k = {k}: {prev:?} → {e:?}");
+            assert!((e[0] - prev[0]).abs() < 0.5, "k = {k}: {prev:?} → {e:?}");
+            prev = e;
+        }
+        // Near θ = 0 the frame fixes only φ + ψ.
+        let pose = super::EndPose::at(&model, [0.0; 3], [0.2, 1e-4, 0.3]);
+        assert_eq!(pose.angles.len(), 2);
+    }
 }
