@@ -207,14 +207,13 @@ impl Trajectory {
     /// The trajectory of the controlled end along `path(z)` at the path parameters `ks`
     /// (increasing; the replay's steps), with the held end's pose from the path's start.
     pub fn along(model: &Model, path: &DeformationPath, z: &[f64], ks: &[f64]) -> Trajectory {
-        let shapes = std::iter::once(0.0).chain(ks.iter().copied()).map(|k| {
+        let shape_at = |k: f64| {
             let mut a = vec![0.0; path.n()];
             path.shape_at(z, k, &mut a);
-            (k, a)
-        });
-        let mut shapes: Vec<(f64, Vec<f64>)> = shapes.collect();
-        let first = shapes.remove(0).1;
-        Self::of_shapes(model, &first, &shapes)
+            a
+        };
+        let shapes: Vec<(f64, Vec<f64>)> = ks.iter().map(|&k| (k, shape_at(k))).collect();
+        Self::of_shapes(model, &shape_at(0.0), &shapes)
     }
 
     /// The trajectory of the controlled end of the shapes `(k, a)` (increasing `k`), with the
