@@ -19,7 +19,7 @@ use super::judge::Judged;
 use super::observer::PlanObserver;
 use super::replay::EarlyStop;
 use crate::rod::model::Model;
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::sync::Arc;
 
 /// Lifts of the pose lines tried, in order (units of L).
@@ -54,15 +54,15 @@ enum Turn {
     },
 }
 
+/// The unit quaternion of rotation `m` ([`super::trajectory::quaternion_of`]).
 fn quaternion(m: [[f64; 3]; 3]) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(Matrix3::from_fn(
-        |i, j| m[i][j],
-    )))
+    let [w, x, y, z] = super::trajectory::quaternion_of(m);
+    UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z))
 }
 
+/// The rotation of `q` ([`super::trajectory::rotation_of_quaternion`]).
 fn matrix(q: &UnitQuaternion<f64>) -> [[f64; 3]; 3] {
-    let r = q.to_rotation_matrix();
-    std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
+    super::trajectory::rotation_of_quaternion([q.w, q.i, q.j, q.k])
 }
 
 impl PoseLine {
