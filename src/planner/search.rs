@@ -2,6 +2,7 @@
 //! plan judged, the chosen plan's report, and the plan again towards a goal pose's equilibrium
 //! the gripper's motion reaches.
 
+use super::equilibrium_plan::EquilibriumPlan;
 use super::judge::Judged;
 use super::observer::{PathKind, PlanObserver, RecordedShapes, ShapeRecord};
 use super::result::{Attempt, PlanResult, PlanStatus, StartSummary, Timing};
@@ -245,13 +246,17 @@ impl Planner {
                 });
             // The straight-line path's trajectory, then the pose lines in increasing lift; the
             // first whose equilibria pass is the plan.
+            // Of those that fail, only why is kept (not their replayed shapes).
             let mut found = None;
-            let mut failed: Vec<(String, Judged)> = Vec::new();
+            let mut failed: Vec<(String, Option<EquilibriumPlan>)> = Vec::new();
             let s = self.judge_straight_trajectory(&fine, observer);
             if s.executable {
                 found = Some(s);
             } else {
-                failed.push(("along the straight path's trajectory".into(), s));
+                failed.push((
+                    "along the straight path's trajectory".into(),
+                    s.equilibrium_plan,
+                ));
                 for lift in pose_line::LIFTS {
                     if !self.settings.pose_lines || self.stopped() || self.time_up() {
                         break;
@@ -266,7 +271,7 @@ impl Planner {
                     } else {
                         "along the end's pose line".into()
                     };
-                    failed.push((what, s));
+                    failed.push((what, s.equilibrium_plan));
                 }
             }
             if let Some(mut s) = found {
@@ -276,8 +281,8 @@ impl Planner {
                 judged = s;
                 along_other = true;
             } else if let Some(e) = judged.equilibrium_plan.as_mut() {
-                for (what, s) in &failed {
-                    if let Some(f) = &s.equilibrium_plan {
+                for (what, f) in &failed {
+                    if let Some(f) = f {
                         e.retry_failed_as(what, f);
                     }
                 }
