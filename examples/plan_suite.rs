@@ -5,6 +5,7 @@
 //!     cargo run --release --example plan_suite -- --seed 1 --planar 60 --spatial 30 --verbose
 //!     cargo run --release --example plan_suite -- --seed 1 --write target/suite   # the case files
 //!     cargo run --release --example plan_suite -- --seed 1 --only 3d   # plan the 3D problems only
+//!     cargo run --release --example plan_suite -- --seed 1 --only none --write target/suite
 //!     cargo run --release --example plan_suite -- --seed 1 --plan '{"path_terms": 4}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"angle_frame": "case"}'
 //!     cargo run --release --example plan_suite -- --seed 1 --case '{"rod": {"radius": 0.03}}'
@@ -692,12 +693,17 @@ fn main() {
             (v[0], v[1])
         });
     // `--only planar` or `--only 3d`: the other kind's problems are generated (the stream of
-    // problems stays the same) but not planned.
+    // problems stays the same) but not planned; `--only none` plans none (with `--write`, the
+    // case files alone).
     let only = args
         .iter()
         .position(|a| a == "--only")
         .and_then(|i| args.get(i + 1))
-        .map(|k| if k == "planar" { 0 } else { 1 });
+        .map(|k| match k.as_str() {
+            "planar" => 0,
+            "none" => 2,
+            _ => 1,
+        });
     let generate = |kind: usize, rng: &mut Rng, i: usize| {
         let text = if kind == 0 && hanging {
             hanging_problem(rng, i)
@@ -794,7 +800,7 @@ fn main() {
                         }
                         if o.reached_not_replanned {
                             eprintln!(
-                                "{:16} executable by its first plan's equilibria, which end on another equilibrium of the goal pose",
+                                "{:16} executable by its first search's equilibria, which end on another equilibrium of the goal pose",
                                 o.name
                             );
                         } else if o.reached_goal {
@@ -837,10 +843,11 @@ fn main() {
         "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    if n_planar > 0 {
+    // (A kind not planned, `--only`, has no row.)
+    if n_planar > 0 && only.is_none_or(|o| o == 0) {
         print!("{}", table(planar_kind, &results[0]));
     }
-    if n_spatial > 0 {
+    if n_spatial > 0 && only.is_none_or(|o| o == 1) {
         print!("{}", table(spatial_label, &results[1]));
     }
     // A plan called collision-free (or executable by its replayed equilibria) that the finer

@@ -86,9 +86,23 @@ pub struct EquilibriumPlan {
     pub(crate) dips: bool,
     /// Where the replay converges, stays stable and never snaps but ends on another
     /// equilibrium of the goal pose than the goal shape, its shapes clear of the obstacles:
-    /// that equilibrium's coefficients (the replay's last shape).
+    /// that equilibrium's coefficients (the replay's last shape) and the trajectory that
+    /// reached it; then those of the second attempts that failed ([`Self::retry_failed_as`]),
+    /// in the order they ran.
     #[serde(skip)]
-    pub(crate) reached_goal: Option<Vec<f64>>,
+    pub(crate) reached_goals: Vec<Reached>,
+}
+
+/// Another equilibrium of the goal pose that replayed equilibria reached
+/// ([`EquilibriumPlan::reached_goals`]), and along which trajectory.
+#[derive(Clone, Debug)]
+pub(crate) struct Reached {
+    /// Its Ritz coefficients (the replay's last shape).
+    pub(crate) a: Vec<f64>,
+    /// [`EquilibriumPlan::trajectory`] of the equilibria that reached it.
+    pub(crate) trajectory: &'static str,
+    /// Along a pose line, its lift ([`EquilibriumPlan::lift_over_l`]).
+    pub(crate) lift_over_l: Option<f64>,
 }
 
 impl EquilibriumPlan {
@@ -99,14 +113,24 @@ impl EquilibriumPlan {
     }
 
     /// [`Self::retry_failed`] with the reason of `retry`, the equilibria of a second attempt
-    /// (`attempt`: what it changed), which are no plan either; where these reached no other
-    /// equilibrium of the goal pose, the one `retry` reached, if any.
+    /// (`attempt`: what it changed), which are no plan either; the other equilibria of the
+    /// goal pose `retry` reached follow these' ([`Self::reached_goals`]).
     pub(super) fn retry_failed_as(&mut self, attempt: &str, retry: &EquilibriumPlan) {
         if let Some(why) = &retry.reason {
             self.retry_failed(attempt, why);
         }
-        if self.reached_goal.is_none() {
-            self.reached_goal.clone_from(&retry.reached_goal);
+        self.reached_goals
+            .extend(retry.reached_goals.iter().cloned());
+    }
+
+    /// These equilibria follow `trajectory` (with `lift_over_l` along a pose line), as do
+    /// those that reached another equilibrium of the goal pose.
+    pub(super) fn set_trajectory(&mut self, trajectory: &'static str, lift_over_l: Option<f64>) {
+        self.trajectory = trajectory;
+        self.lift_over_l = lift_over_l;
+        for r in &mut self.reached_goals {
+            r.trajectory = trajectory;
+            r.lift_over_l = lift_over_l;
         }
     }
 }
@@ -312,7 +336,7 @@ impl Planner {
             lift_over_l: None,
             optimal_path_not_executable: None,
             dips: false,
-            reached_goal: None,
+            reached_goals: Vec::new(),
         };
         if plan.reason.is_none() {
             let (why, clearance, dips) = penetration(self, fine, first);
@@ -326,11 +350,12 @@ impl Planner {
             // may be their artefact, and the shapes are replayed again as any that dip are.
             let (why, clearance, dips) = penetration(self, fine, first);
             if why.is_none() {
-                plan.reached_goal = first
-                    .steps
-                    .last()
-                    .filter(|s| s.k == 1.0)
-                    .map(|s| s.a.clone());
+                plan.reached_goals
+                    .extend(first.steps.last().filter(|s| s.k == 1.0).map(|s| Reached {
+                        a: s.a.clone(),
+                        trajectory: plan.trajectory,
+                        lift_over_l: None,
+                    }));
             } else if dips {
                 plan.min_clearance = clearance;
                 plan.dips = true;

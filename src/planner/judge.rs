@@ -90,6 +90,29 @@ impl Planner {
         )
     }
 
+    /// `judge(self)`, or, where its equilibria still dip into an obstacle between the chords
+    /// of the case's contact samples, `judge` of the copy that judges them again on twice as
+    /// many ([`Planner::finer_contacts`]), as the optimised plans' are when nothing executes.
+    pub(super) fn with_finer_if_dipping(
+        &self,
+        mut judge: impl FnMut(&Planner) -> Judged,
+    ) -> Judged {
+        let j = judge(self);
+        if j.executable
+            || !j.dips_on_case_samples
+            || self.finer_retry
+            || self.finer_contacts.is_none()
+            || self.stopped()
+            || self.time_up()
+        {
+            return j;
+        }
+        judge(&Planner {
+            finer_retry: true,
+            ..self.clone()
+        })
+    }
+
     /// The replay of `path(z)` from the start shape under `base` (the held problem, or a copy
     /// with other contacts), with the plan's replay settings, ended early by `early_stop`.
     pub(super) fn replay_under(

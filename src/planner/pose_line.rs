@@ -157,8 +157,7 @@ impl Planner {
         let mut judged =
             driven.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
-            e.trajectory = "pose_line";
-            e.lift_over_l = Some(lift);
+            e.set_trajectory("pose_line", Some(lift));
         }
         judged
     }

@@ -4,29 +4,33 @@
 //! The goal shape of a pose is the equilibrium its static solve finds, a local search from the
 //! natural state (or a rod bent towards the pose), and a pose can hold several: a heavy cable
 //! sags one way or another, a strip buckles up or down. Where no plan to that shape executes
-//! but the replay of the best one — the rod's equilibria as the gripper follows its
-//! trajectory — converges, stays stable, never snaps, keeps clear of every obstacle and ends on
-//! another equilibrium of the goal pose, the gripper does bring the rod to the goal pose, in
-//! that shape. (Where such shapes dip into an obstacle between the solves' contact points,
+//! but a replay — the rod's equilibria as the gripper follows the best plan's trajectory, or
+//! the straight-line path's or a pose line tried after it — converges, stays stable, never
+//! snaps, keeps clear of every obstacle and ends on another equilibrium of the goal pose, the
+//! gripper does bring the rod to the goal pose, in that shape. (Where such shapes dip into an obstacle between the solves' contact points,
 //! they are first replayed on the chords between them, as any that dip are: the other
 //! equilibrium can be the dip's artefact.) The planner then plans again with that shape as the goal (solved at the goal
 //! shape's end pose, which the replay held), and reports that plan where it is executable,
 //! with both shapes' energies and how far apart they are
 //! ([`super::PlanResult::reached_goal`]). The replay of the new plan is its verdict, as for any
-//! plan. Where it is not executable, the first plan's replayed equilibria, which end on that
-//! equilibrium, are judged again with it accepted as their end, every other check as before;
-//! where they pass they are the plan (with `replan_failed`), else the first plan is reported, with
-//! what the second met.
+//! plan. Where it is not executable, the equilibria along each trajectory that ended on another
+//! equilibrium of the goal pose, in the order they were tried, are judged again with the one
+//! they reached accepted as their end, every other check as before; the first that passes is
+//! the plan (with `replan_failed`), else the first plan is reported, with what the second met.
 
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
-use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
+use super::equilibrium_plan::Reached;
+use super::judge::Judged;
+use super::observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
 use super::path::DeformationPath;
 use super::replay::{EarlyStop, max_distance};
 use super::result::{PlanResult, PlanStatus, PlanVerdict, ReachedGoal};
 use super::trajectory::Trajectory;
 use super::verify::fine_model;
-use super::{Planner, endpoints::EndPose};
-use crate::statics::SolveStatus;
+use super::{Planner, clearance, endpoints::EndPose};
+use crate::rod::kinematics::Shape;
+use crate::rod::model::Model;
+use crate::statics::{SolveStatus, StaticSolution};
 use std::sync::Arc;
 
 impl Planner {
@@ -41,14 +45,14 @@ impl Planner {
         p.path()
     }
 
-    /// `result`, or, where it is not executable and the gripper's motion along its trajectory
-    /// reached another equilibrium of a goal given by its pose alone, the plan to that
-    /// equilibrium where that one is executable, else `result` with its replayed equilibria
-    /// judged again with that end accepted, where they pass; with the reported plan's replayed
-    /// shapes (`replayed`, the second search's or the second judgement's) passed on to
-    /// `observer`. The second search's other
-    /// shapes are not passed on but for its goal shape, at `k = 1` after the first's: the
-    /// first search's end shapes and straight path were passed on as they came, and a log
+    /// `result`, or, where it is not executable and the gripper's motion along one of its
+    /// search's trajectories reached another equilibrium of a goal given by its pose alone,
+    /// the plan to that equilibrium where that one is executable, else `result` with the
+    /// equilibria of the first trajectory that passes, judged again with the end it reached
+    /// accepted; with the reported plan's replayed shapes (`replayed`, the second search's or
+    /// the second judgement's) passed on to `observer`. The second search's other shapes are
+    /// not passed on but for the goal shape the plan ends on, at `k = 1` after the first's:
+    /// the first search's end shapes and straight path were passed on as they came, and a log
     /// holds one of each along `k` (its optimiser's progress is passed on as it comes).
     pub(super) fn towards_reached_goal(
         &self,
@@ -81,35 +85,88 @@ impl Planner {
         result.timing_s.plan += again.timing_s.plan;
         result.timing_s.replay += again.timing_s.replay;
         result.time_limit_reached |= again.time_limit_reached;
-        // The first plan's equilibria, which bring the rod to that equilibrium of the goal
-        // pose, judged again with that end accepted (every other check as before).
-        let along_optimal = result
+        // The equilibria along each trajectory that reached another equilibrium of the goal
+        // pose, in the order they were judged, judged again with that end accepted (every
+        // other check as before): the first that passes is the plan.
+        let replanned_to = reached.shape.clone();
+        let tried = result
             .equilibrium_plan
             .as_ref()
-            .is_some_and(|e| e.trajectory == "optimal_path");
-        if along_optimal && !self.stopped() && !self.time_up() {
+            .map(|e| routes(&e.reached_goals))
+            .unwrap_or_default();
+        let fine = fine_model(model, self.verify_s_intervals(), 4);
+        for route in tried {
+            if self.stopped() || self.time_up() {
+                break;
+            }
+            let Some((mut this, sol)) = self.reached_equilibrium(&route.a, &result) else {
+                continue;
+            };
             let accepting = Planner {
-                ends_on: Some(Arc::new(model.evaluate(&reached.shape).positions)),
+                ends_on: Some(Arc::new(model.evaluate(&this.shape).positions)),
                 ..self.clone()
             };
-            let path = self.path_of(&result);
-            let fine = fine_model(model, self.verify_s_intervals(), 4);
-            let planned = result.status == PlanStatus::Planned;
-            let j =
-                accepting.judge_path(&path, &result.z, planned, EarlyStop::Never, &fine, observer);
+            let j = accepting.judge_route(&route, &result, &fine, observer);
             result.timing_s.replay += j.seconds;
-            if j.executable {
-                flush(&searched.goal_shape(), model, observer);
-                flush(&j.shapes, model, observer);
-                let ks: Vec<f64> = j.replay.steps.iter().map(|s| s.k).collect();
-                result.trajectory = Trajectory::along(model, &path, &result.z, &ks);
-                result.replay = j.replay;
-                result.equilibrium_plan = j.equilibrium_plan;
-                result.workspace = j.workspace.or(result.workspace);
-                reached.replan_failed = Some(again.verdict().to_string());
-                result.reached_goal = Some(reached);
-                return result;
+            if !j.executable {
+                continue;
             }
+            // The goal shape the plan ends on: the second search's, or this one.
+            if this.shape == replanned_to {
+                flush(&searched.goal_shape(), model, observer);
+            } else {
+                let sh = model.evaluate(&sol.a);
+                observer.shape(
+                    model,
+                    &ShapeRecord {
+                        kind: PathKind::Endpoint,
+                        k: 1.0,
+                        a: &sol.a,
+                        energy: sol.energy,
+                        clearance: clearance(&self.base, &sh.positions),
+                        deviation: None,
+                        stable: sol.stable,
+                        reactions: &sol.reactions,
+                        violation: Some(sol.max_violation),
+                    },
+                );
+            }
+            flush(&j.shapes, model, observer);
+            this.first_plan_seconds = reached.first_plan_seconds;
+            this.replan_failed = Some(if this.shape == replanned_to {
+                again.verdict().to_string()
+            } else {
+                format!(
+                    "not planned again to it; the plan made again to the equilibrium {:.3e} L from the goal shape that another trajectory reached: {}",
+                    reached.distance_over_l,
+                    again.verdict()
+                )
+            });
+            let ks: Vec<f64> = j.replay.steps.iter().map(|s| s.k).collect();
+            result.trajectory = match route.trajectory {
+                "pose_line" => {
+                    let shapes: Vec<(f64, Vec<f64>)> =
+                        j.replay.steps.iter().map(|s| (s.k, s.a.clone())).collect();
+                    Trajectory::of_shapes(model, &self.start.a, &shapes)
+                }
+                "straight_path" => {
+                    let path = self.path();
+                    Trajectory::along(model, &path, &vec![0.0; path.n_vars()], &ks)
+                }
+                _ => Trajectory::along(model, &self.path_of(&result), &result.z, &ks),
+            };
+            result.replay = j.replay;
+            result.equilibrium_plan = j.equilibrium_plan;
+            if let Some(e) = result
+                .equilibrium_plan
+                .as_mut()
+                .filter(|e| e.trajectory != "optimal_path")
+            {
+                e.optimal_path_not_executable = Some(this.first_plan.clone());
+            }
+            result.workspace = j.workspace.or(result.workspace);
+            result.reached_goal = Some(this);
+            return result;
         }
         flush(&replayed, model, observer);
         if let Some(e) = result.equilibrium_plan.as_mut() {
@@ -124,13 +181,48 @@ impl Planner {
         result
     }
 
+    /// The equilibria along `route`'s trajectory (that of `result`'s optimal path, of the
+    /// straight-line path or a pose line), judged again by this planner, with the optimal
+    /// path's shapes recorded as those of `result`'s path.
+    fn judge_route(
+        &self,
+        route: &Reached,
+        result: &PlanResult,
+        fine: &Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let path = self.path_of(result);
+        let mut j = match (route.trajectory, route.lift_over_l) {
+            ("pose_line", Some(lift)) => {
+                self.with_finer_if_dipping(|pl| pl.judge_pose_line(lift, fine, observer))
+            }
+            ("straight_path", _) => {
+                self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer))
+            }
+            _ => {
+                let planned = result.status == PlanStatus::Planned;
+                return self.with_finer_if_dipping(|pl| {
+                    pl.judge_path(&path, &result.z, planned, EarlyStop::Never, fine, observer)
+                });
+            }
+        };
+        // (A replay of another trajectory records that trajectory's shapes as its optimal ones.)
+        let mut a = vec![0.0; path.n()];
+        let mut sh = Shape::default();
+        j.shapes.set_optimal(|k| {
+            let (e, c) = self.path_shape(&path, &result.z, k, &mut a, &mut sh);
+            (a.clone(), e, c)
+        });
+        j
+    }
+
     /// The planner with the goal shape the gripper's motion reached in `result`'s replay, and
     /// what it reports, where [`super::PlanSettings::reached_goal`] applies: a goal given by
     /// its pose alone, not planned again yet; a plan that is not executable, found before any
-    /// stop or time limit, whose replayed equilibria converge, stay stable, never snap and keep
-    /// clear of the obstacles but end on another equilibrium of the goal pose; that equilibrium, solved again at the goal shape's end
-    /// pose under the planner's problem, converged, stable, within the coincidence tolerance of
-    /// the replay's last shape and beyond it from the goal shape.
+    /// stop or time limit, whose replayed equilibria (along the optimal path's trajectory, or
+    /// the straight-line path's or a pose line's tried after it) converge, stay stable, never
+    /// snap and keep clear of the obstacles but end on another equilibrium of the goal pose:
+    /// the first such equilibrium [`Self::reached_equilibrium`] accepts.
     fn reached_goal_planner(&self, result: &PlanResult) -> Option<(Planner, ReachedGoal)> {
         if !(self.settings.reached_goal && self.goal_by_pose)
             || result.verdict().is_executable()
@@ -143,7 +235,25 @@ impl Planner {
             return None;
         }
         let ep = result.equilibrium_plan.as_ref()?;
-        let a = ep.reached_goal.as_deref()?;
+        let reached = ep
+            .reached_goals
+            .iter()
+            .find_map(|r| self.reached_equilibrium(&r.a, result))?;
+        let mut planner = self.clone();
+        planner.goal = reached.1;
+        planner.goal_by_pose = false;
+        Some((planner, reached.0))
+    }
+
+    /// The equilibrium `a`, the last shape of replayed equilibria of `result`, solved again at
+    /// the goal shape's end pose under the planner's problem, and what it reports, where that
+    /// solve converged, is stable, within the coincidence tolerance of `a` and beyond it from
+    /// the goal shape.
+    fn reached_equilibrium(
+        &self,
+        a: &[f64],
+        result: &PlanResult,
+    ) -> Option<(ReachedGoal, StaticSolution)> {
         let model = &self.base.model;
         let goal_positions = model.evaluate(&self.goal.a).positions;
         let pose = EndPose::of(model, &self.goal.a, &goal_positions);
@@ -168,11 +278,15 @@ impl Planner {
         if from_goal <= tolerance || from_reached > tolerance {
             return None;
         }
+        let reason = result
+            .equilibrium_plan
+            .as_ref()
+            .and_then(|e| e.reason.as_deref());
         let reached = ReachedGoal {
             solved_energy: self.goal.energy.internal(),
             energy: sol.energy.internal(),
             distance_over_l: from_goal,
-            first_plan: match ep.reason.as_deref() {
+            first_plan: match reason {
                 Some(why) => format!("{}; equilibria: {why}", result.verdict()),
                 None => result.verdict().to_string(),
             },
@@ -180,9 +294,98 @@ impl Planner {
             shape: sol.a.clone(),
             replan_failed: None,
         };
-        let mut planner = self.clone();
-        planner.goal = sol;
-        planner.goal_by_pose = false;
-        Some((planner, reached))
+        Some((reached, sol))
+    }
+}
+
+/// The trajectories of `reached` (those that reached another equilibrium of the goal pose),
+/// each once, with the first equilibrium it reached, in their order.
+fn routes(reached: &[Reached]) -> Vec<Reached> {
+    let mut out: Vec<Reached> = Vec::new();
+    for r in reached {
+        if !out
+            .iter()
+            .any(|o| o.trajectory == r.trajectory && o.lift_over_l == r.lift_over_l)
+        {
+            out.push(r.clone());
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::equilibrium_plan::{EquilibriumPlan, Reached};
+
+    /// Equilibria that ended on `a` (one coefficient) along the optimal path's trajectory.
+    fn ended_on(a: f64) -> EquilibriumPlan {
+        EquilibriumPlan {
+            executable: false,
+            reason: Some("the replay ends elsewhere".into()),
+            u_max: 1.0,
+            k_at_u_max: 1.0,
+            min_clearance: None,
+            max_contact_force: 0.0,
+            k_at_max_contact_force: 0.0,
+            confirmation_steps: None,
+            confirmation_deviation_over_l: None,
+            contact: "points",
+            contact_margin: None,
+            contact_samples: None,
+            trajectory: "optimal_path",
+            lift_over_l: None,
+            optimal_path_not_executable: None,
+            dips: false,
+            reached_goals: vec![Reached {
+                a: vec![a],
+                trajectory: "optimal_path",
+                lift_over_l: None,
+            }],
+        }
+    }
+
+    /// The equilibria reached along the trajectories tried after a plan's own follow its own,
+    /// each with the trajectory that reached it; each trajectory is judged again once, with
+    /// the first equilibrium it reached.
+    #[test]
+    fn reached_equilibria_keep_their_order_and_trajectory() {
+        let mut plan = ended_on(1.0);
+        let on_chords = ended_on(2.0);
+        plan.retry_failed_as("replayed with contacts on chords", &on_chords);
+        let mut straight = ended_on(3.0);
+        straight.set_trajectory("straight_path", None);
+        let mut line = ended_on(4.0);
+        line.set_trajectory("pose_line", Some(0.3));
+        let mut higher = ended_on(5.0);
+        higher.set_trajectory("pose_line", Some(0.5));
+        for (what, retry) in [
+            ("straight", &straight),
+            ("line", &line),
+            ("higher", &higher),
+        ] {
+            plan.retry_failed_as(what, retry);
+        }
+        let got: Vec<(f64, &str, Option<f64>)> = plan
+            .reached_goals
+            .iter()
+            .map(|r| (r.a[0], r.trajectory, r.lift_over_l))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (1.0, "optimal_path", None),
+                (2.0, "optimal_path", None),
+                (3.0, "straight_path", None),
+                (4.0, "pose_line", Some(0.3)),
+                (5.0, "pose_line", Some(0.5)),
+            ]
+        );
+        let routes: Vec<f64> = super::routes(&plan.reached_goals)
+            .iter()
+            .map(|r| r.a[0])
+            .collect();
+        assert_eq!(routes, [1.0, 3.0, 4.0, 5.0]);
+        assert_eq!(line.trajectory, "pose_line");
+        assert_eq!(line.lift_over_l, Some(0.3));
     }
 }

@@ -269,10 +269,10 @@ pub struct PlanResult {
 
 /// The goal shape a plan ends on where it is not the one the goal pose's static solve found
 /// ([`PlanResult::reached_goal`]): no plan to that one was executable, and the gripper's
-/// motion along the best plan's trajectory brought the rod to this equilibrium of the same
-/// pose (stable, clear of the obstacles), so the plan was made again to it, or, where that
-/// plan was not executable, that motion's replayed equilibria are the plan
-/// ([`ReachedGoal::replanned`]).
+/// motion along a trajectory of the search (the best plan's, the straight-line path's or a
+/// pose line) brought the rod to this equilibrium of the same pose (stable, clear of the
+/// obstacles), so the plan was made again to it, or, where that plan was not executable, that
+/// motion's replayed equilibria are the plan ([`ReachedGoal::replanned`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct ReachedGoal {
     /// Internal energy of the goal shape the static solve found (case units).
@@ -286,10 +286,12 @@ pub struct ReachedGoal {
     pub shape: Vec<f64>,
     /// Why the first plan was not executable: its verdict and what its equilibria met.
     pub first_plan: String,
-    /// Where the plan made again to this goal shape was not executable: its verdict; the plan
-    /// is then the first plan's replayed equilibria, which end on this shape, and the first
-    /// plan's path still ends on the goal shape the static solve found. Absent where the plan
-    /// is the one made again ([`ReachedGoal::replanned`]).
+    /// Where the plan made again to a reached goal shape was not executable: its verdict
+    /// (saying so where it was made to another equilibrium the first search reached); the plan
+    /// is then replayed equilibria of the first search, which end on this shape (along the
+    /// trajectory [`super::equilibrium_plan::EquilibriumPlan::trajectory`] names), and the first plan's path
+    /// still ends on the goal shape the static solve found. Absent where the plan is the one
+    /// made again ([`ReachedGoal::replanned`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replan_failed: Option<String>,
     /// Seconds the first plan's search took (in [`PlanResult::timing_s`] too).

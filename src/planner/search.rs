@@ -249,30 +249,28 @@ impl Planner {
             // Of those that fail, only why is kept (not their replayed shapes).
             let mut found = None;
             let mut failed: Vec<(String, Option<EquilibriumPlan>)> = Vec::new();
-            let s = self.judge_straight_trajectory(&fine, observer);
-            if s.executable {
-                found = Some(s);
-            } else {
-                failed.push((
-                    "along the straight path's trajectory".into(),
-                    s.equilibrium_plan,
-                ));
-                for lift in pose_line::LIFTS {
-                    if !self.settings.pose_lines || self.stopped() || self.time_up() {
-                        break;
-                    }
-                    let s = self.judge_pose_line(lift, &fine, observer);
-                    if s.executable {
-                        found = Some(s);
-                        break;
-                    }
-                    let what = if lift > 0.0 {
-                        format!("along the end's pose line lifted {lift} L")
-                    } else {
-                        "along the end's pose line".into()
-                    };
-                    failed.push((what, s.equilibrium_plan));
+            let along =
+                |pl: &Planner, lift: Option<f64>, observer: &mut dyn PlanObserver| match lift {
+                    None => pl.judge_straight_trajectory(&fine, observer),
+                    Some(h) => pl.judge_pose_line(h, &fine, observer),
+                };
+            let lines = pose_line::LIFTS.map(Some);
+            for lift in std::iter::once(None).chain(lines) {
+                if lift.is_some() && (!self.settings.pose_lines || self.stopped() || self.time_up())
+                {
+                    break;
                 }
+                let s = self.with_finer_if_dipping(|pl| along(pl, lift, observer));
+                if s.executable {
+                    found = Some(s);
+                    break;
+                }
+                let what = match lift {
+                    None => "along the straight path's trajectory".into(),
+                    Some(h) if h > 0.0 => format!("along the end's pose line lifted {h} L"),
+                    Some(_) => "along the end's pose line".into(),
+                };
+                failed.push((what, s.equilibrium_plan));
             }
             if let Some(mut s) = found {
                 if let Some(e) = s.equilibrium_plan.as_mut() {

@@ -164,7 +164,7 @@ impl Planner {
         let z = vec![0.0; path.n_vars()];
         let mut judged = self.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
-            e.trajectory = "straight_path";
+            e.set_trajectory("straight_path", None);
         }
         judged
     }

@@ -502,9 +502,21 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             g.energy, g.distance_over_l, g.solved_energy, g.first_plan
         );
         if let Some(why) = &g.replan_failed {
+            let along = match p
+                .equilibrium_plan
+                .as_ref()
+                .map(|e| (e.trajectory, e.lift_over_l))
+            {
+                Some(("pose_line", Some(h))) if h > 0.0 => {
+                    format!("along the end's pose line lifted {h} L")
+                }
+                Some(("pose_line", _)) => "along the end's pose line".into(),
+                Some(("straight_path", _)) => "along the straight path's trajectory".into(),
+                _ => "along the first plan's trajectory".into(),
+            };
             let _ = writeln!(
                 o,
-                "  the plan is the first plan's replayed equilibria, which end on it (the plan made again to it: {why})"
+                "  the plan is the first search's replayed equilibria {along}, which end on it (planned again: {why})"
             );
         }
     }
