@@ -327,8 +327,8 @@ pub struct Outcome {
     /// Of those, along the straight-line path's trajectory (no optimised path executable).
     pub by_straight: bool,
     /// Of those, along a line in the end's pose space (neither an optimised path nor the
-    /// straight-line path's trajectory executable): its lift (units of L).
-    pub by_pose_line: Option<f64>,
+    /// straight-line path's trajectory executable): how it leaves the straight line.
+    pub by_pose_line: Option<dlo_planner::planner::pose_line::Detour>,
     /// The plan ends on another equilibrium of the goal pose than its static solve's, which
     /// the gripper's motion reached (`PlanResult::reached_goal`).
     pub reached_goal: bool,
@@ -792,10 +792,14 @@ fn main() {
                             o.replay.2,
                             o.attempts
                         );
-                        if let Some(h) = o.by_pose_line {
+                        if let Some(d) = o.by_pose_line {
                             eprintln!(
-                                "{:16} executable along a line in the end's pose space lifted {h} L",
-                                o.name
+                                "{:16} executable along a line in the end's pose space {}",
+                                o.name,
+                                match d.describe() {
+                                    d if d.is_empty() => "lifted 0 L".to_string(),
+                                    d => d,
+                                }
                             );
                         }
                         if o.reached_not_replanned {

@@ -21,6 +21,7 @@
 use super::Planner;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
+use super::pose_line::Detour;
 use super::replay::{EarlyStop, Replay, ReplayOptions, max_distance, replay_driven};
 use crate::constraints::Constraint;
 use crate::rod::model::Model;
@@ -77,6 +78,11 @@ pub struct EquilibriumPlan {
     /// Along a pose line: how far it lifts the end mid-way against gravity (units of L).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lift_over_l: Option<f64>,
+    /// Along a pose line moved aside: how far it moves the end mid-way across the straight
+    /// line, horizontally (units of L; along `up × (goal − start)` where positive,
+    /// [`super::pose_line::Detour`]). Absent on lines not moved aside.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub side_over_l: Option<f64>,
     /// Along another trajectory than the optimal path's: why the optimal path was not
     /// executable, as it stands or by its equilibria (`None` otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -101,8 +107,8 @@ pub(crate) struct Reached {
     pub(crate) a: Vec<f64>,
     /// [`EquilibriumPlan::trajectory`] of the equilibria that reached it.
     pub(crate) trajectory: &'static str,
-    /// Along a pose line, its lift ([`EquilibriumPlan::lift_over_l`]).
-    pub(crate) lift_over_l: Option<f64>,
+    /// Along a pose line, how it leaves the straight line.
+    pub(crate) line: Option<Detour>,
 }
 
 impl EquilibriumPlan {
@@ -123,15 +129,24 @@ impl EquilibriumPlan {
             .extend(retry.reached_goals.iter().cloned());
     }
 
-    /// These equilibria follow `trajectory` (with `lift_over_l` along a pose line), as do
-    /// those that reached another equilibrium of the goal pose.
-    pub(super) fn set_trajectory(&mut self, trajectory: &'static str, lift_over_l: Option<f64>) {
+    /// These equilibria follow `trajectory` (`line` along a pose line), as do those that
+    /// reached another equilibrium of the goal pose.
+    pub(super) fn set_trajectory(&mut self, trajectory: &'static str, line: Option<Detour>) {
         self.trajectory = trajectory;
-        self.lift_over_l = lift_over_l;
+        self.lift_over_l = line.map(|d| d.lift);
+        self.side_over_l = line.map(|d| d.side).filter(|&s| s != 0.0);
         for r in &mut self.reached_goals {
             r.trajectory = trajectory;
-            r.lift_over_l = lift_over_l;
+            r.line = line;
         }
+    }
+
+    /// Along a pose line, how it leaves the straight line.
+    pub fn pose_line(&self) -> Option<Detour> {
+        (self.trajectory == "pose_line").then(|| Detour {
+            lift: self.lift_over_l.unwrap_or(0.0),
+            side: self.side_over_l.unwrap_or(0.0),
+        })
     }
 }
 
@@ -334,6 +349,7 @@ impl Planner {
             contact_samples: None,
             trajectory: "optimal_path",
             lift_over_l: None,
+            side_over_l: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: Vec::new(),
@@ -354,7 +370,7 @@ impl Planner {
                     .extend(first.steps.last().filter(|s| s.k == 1.0).map(|s| Reached {
                         a: s.a.clone(),
                         trajectory: plan.trajectory,
-                        lift_over_l: None,
+                        line: None,
                     }));
             } else if dips {
                 plan.min_clearance = clearance;

@@ -6,12 +6,13 @@
 //! end as their shapes do, and the end poses of a heavy cable's shapes can press it into a
 //! table it rests on, or turn the end the long way round. A pose line moves the end's
 //! position along the straight line from the start's to the goal's, raised against gravity by
-//! `lift · 4k(1 − k)` (units of L: the highest mid-way), and turns its frame along the
-//! shortest rotation between the two (a slerp), its Euler angles continued from the start's.
-//! Lifted, the cable hangs clear of what it would be dragged over, instead of snapping across
-//! it. The replayed equilibria along it are judged exactly as those along the other
-//! trajectories ([`super::equilibrium_plan`]); the lifts are tried in increasing order, and the
-//! first that passes is the plan.
+//! `lift · 4k(1 − k)` or moved across it horizontally by `side · 4k(1 − k)` (units of L: the
+//! farthest mid-way; [`Detour`]), and turns its frame along the shortest rotation between the
+//! two (a slerp), its Euler angles continued from the start's. Lifted, the cable hangs clear
+//! of what it would be dragged over, instead of snapping across it; moved aside, it can keep to
+//! one side. The replayed equilibria along it are judged exactly as those along the other
+//! trajectories ([`super::equilibrium_plan`]); the lines are tried in the order of
+//! [`DETOURS`], and the first that passes is the plan.
 
 use super::Planner;
 use super::endpoints::EndPose;
@@ -22,8 +23,67 @@ use crate::rod::model::Model;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::sync::Arc;
 
-/// Lifts of the pose lines tried, in order (units of L).
-pub const LIFTS: [f64; 4] = [0.0, 0.15, 0.3, 0.5];
+/// How far a pose line leaves the straight line between the end positions mid-way (units of
+/// L; `4k(1 − k)` times it at `k`): `lift` against gravity (along `x` on a rod without weight),
+/// and `side` across, horizontally, along `up × (goal − start)` (against it where negative).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detour {
+    /// Against gravity.
+    pub lift: f64,
+    /// Horizontally across the straight line.
+    pub side: f64,
+}
+
+impl Detour {
+    /// How the line is described: `"lifted 0.3 L"`, `"moved aside -0.5 L"`, or `""` (the
+    /// straight line itself).
+    pub fn describe(&self) -> String {
+        match (self.lift, self.side) {
+            (h, s) if h != 0.0 && s != 0.0 => format!("lifted {h} L and moved aside {s} L"),
+            (h, _) if h != 0.0 => format!("lifted {h} L"),
+            (_, s) if s != 0.0 => format!("moved aside {s} L"),
+            _ => String::new(),
+        }
+    }
+}
+
+/// The pose lines tried, in order: lifted by 0, 0.15, 0.3 and 0.5 L, then, on a 3D rod, moved
+/// aside by 0.3 and 0.5 L either way (a heavy cable dragged across a table can snap over
+/// wherever the end is lifted, and keep on one side of the line where it is moved aside).
+pub const DETOURS: [Detour; 8] = [
+    Detour {
+        lift: 0.0,
+        side: 0.0,
+    },
+    Detour {
+        lift: 0.15,
+        side: 0.0,
+    },
+    Detour {
+        lift: 0.3,
+        side: 0.0,
+    },
+    Detour {
+        lift: 0.5,
+        side: 0.0,
+    },
+    Detour {
+        lift: 0.0,
+        side: 0.3,
+    },
+    Detour {
+        lift: 0.0,
+        side: -0.3,
+    },
+    Detour {
+        lift: 0.0,
+        side: 0.5,
+    },
+    Detour {
+        lift: 0.0,
+        side: -0.5,
+    },
+];
 
 /// Steps of `k` on which the Euler angles are continued from the start's.
 const TURN_STEPS: usize = 1024;
@@ -34,10 +94,10 @@ pub struct PoseLine {
     /// Start and goal positions of the end (units of L, the rod's position frame).
     from: [f64; 3],
     to: [f64; 3],
-    /// The lift mid-way (units of L, against gravity).
-    lift: [f64; 3],
-    /// How far it is lifted (units of L).
-    pub lift_over_l: f64,
+    /// The position's offset from the straight line mid-way (units of L).
+    offset: [f64; 3],
+    /// How it leaves the straight line.
+    pub detour: Detour,
     turn: Turn,
 }
 
@@ -66,13 +126,29 @@ fn matrix(q: &UnitQuaternion<f64>) -> [[f64; 3]; 3] {
 }
 
 impl PoseLine {
-    /// The line from the end pose of shape `start` to that of shape `goal`, lifted by `lift`
-    /// (units of L) against gravity (along `x`, the vertical, in the rod's frame).
-    pub fn new(model: &Model, start: &[f64], goal: &[f64], lift: f64) -> PoseLine {
+    /// The line from the end pose of shape `start` to that of shape `goal`, leaving the
+    /// straight line by `detour` (against gravity, along `x` on a rod without weight, and
+    /// across; `None` where it moves aside on a planar rod, or where the straight line is
+    /// vertical and has no horizontal across).
+    pub fn new(model: &Model, start: &[f64], goal: &[f64], detour: Detour) -> Option<PoseLine> {
         let b = model.boundary(1.0);
         let from = model.evaluate(start).positions[b];
         let to = model.evaluate(goal).positions[b];
         let up = model.up().unwrap_or([1.0, 0.0, 0.0]);
+        let chord: [f64; 3] = std::array::from_fn(|i| to[i] - from[i]);
+        let across = [
+            up[1] * chord[2] - up[2] * chord[1],
+            up[2] * chord[0] - up[0] * chord[2],
+            up[0] * chord[1] - up[1] * chord[0],
+        ];
+        let norm = across.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let side = if detour.side == 0.0 {
+            [0.0; 3]
+        } else if !model.layout.spatial || norm <= 1e-9 * model.rod.length {
+            return None;
+        } else {
+            across.map(|v| v / norm)
+        };
         let (e0, e1) = (model.angles_at(start, 1.0), model.angles_at(goal, 1.0));
         let turn = if model.layout.spatial {
             let r = |e: [f64; 3]| quaternion(crate::rod::kinematics::rotation(e[0], e[1], e[2]));
@@ -96,19 +172,19 @@ impl PoseLine {
         } else {
             Turn::Planar(e0[1], e1[1])
         };
-        PoseLine {
+        Some(PoseLine {
             from,
             to,
-            lift: up.map(|u| u * lift),
-            lift_over_l: lift,
+            offset: std::array::from_fn(|i| detour.lift * up[i] + detour.side * side[i]),
+            detour,
             turn,
-        }
+        })
     }
 
     /// The end's position at `k` (units of L).
     pub fn position(&self, k: f64) -> [f64; 3] {
         let h = 4.0 * k * (1.0 - k);
-        std::array::from_fn(|i| (1.0 - k) * self.from[i] + k * self.to[i] + h * self.lift[i])
+        std::array::from_fn(|i| (1.0 - k) * self.from[i] + k * self.to[i] + h * self.offset[i])
     }
 
     /// The end's Euler angles at `k` (`[0, θ, 0]` on a planar rod).
@@ -133,23 +209,23 @@ impl PoseLine {
 }
 
 impl Planner {
-    /// The replayed equilibria along the pose line lifted by `lift` (units of L), judged as a
-    /// plan on the verification model `fine` ([`Self::judge_path`], with the straight-line
-    /// path's shapes as the replay's reference).
+    /// The pose line of `detour` between the end shapes ([`PoseLine::new`]; `None` where
+    /// there is no such line).
+    pub(super) fn pose_line(&self, detour: Detour) -> Option<PoseLine> {
+        PoseLine::new(&self.base.model, &self.start.a, &self.goal.a, detour)
+    }
+
+    /// The replayed equilibria along the pose line `line`, judged as a plan on the
+    /// verification model `fine` ([`Self::judge_path`], with the straight-line path's shapes
+    /// as the replay's reference).
     pub(super) fn judge_pose_line(
         &self,
-        lift: f64,
+        line: &Arc<PoseLine>,
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> Judged {
-        let model = &self.base.model;
         let driven = Planner {
-            drive: Some(Arc::new(PoseLine::new(
-                model,
-                &self.start.a,
-                &self.goal.a,
-                lift,
-            ))),
+            drive: Some(line.clone()),
             ..self.clone()
         };
         let path = self.path();
@@ -157,7 +233,7 @@ impl Planner {
         let mut judged =
             driven.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
-            e.set_trajectory("pose_line", Some(lift));
+            e.set_trajectory("pose_line", Some(line.detour));
         }
         judged
     }
@@ -165,7 +241,12 @@ impl Planner {
 
 #[cfg(test)]
 mod tests {
-    use super::PoseLine;
+    use super::{Detour, PoseLine};
+
+    /// Lifted by `lift`, not moved aside.
+    fn lifted(lift: f64) -> Detour {
+        Detour { lift, side: 0.0 }
+    }
 
     /// The line starts and ends on the end poses of its shapes (angles as the shapes have
     /// them), rises by the lift mid-way, and turns along the shortest rotation: its frames at
@@ -174,7 +255,7 @@ mod tests {
     fn a_pose_line_joins_the_end_poses_and_turns_the_short_way() {
         let p = super::super::paper_planner();
         let model = &p.base.model;
-        let line = PoseLine::new(model, &p.start.a, &p.goal.a, 0.3);
+        let line = PoseLine::new(model, &p.start.a, &p.goal.a, lifted(0.3)).expect("a line");
         let b = model.boundary(1.0);
         for (k, a) in [(0.0, &p.start.a), (1.0, &p.goal.a)] {
             let x = model.evaluate(a).positions[b];
@@ -184,6 +265,71 @@ mod tests {
         }
         let (x0, x1, xm) = (line.position(0.0), line.position(1.0), line.position(0.5));
         assert!((xm[0] - (0.5 * (x0[0] + x1[0]) + 0.3)).abs() < 1e-15);
+        // A planar rod's end cannot leave its plane.
+        let aside = Detour {
+            lift: 0.0,
+            side: 0.3,
+        };
+        assert!(PoseLine::new(model, &p.start.a, &p.goal.a, aside).is_none());
+    }
+
+    /// A 3D end moved aside by `s`: at every `k` its offset from the straight line is
+    /// `s · 4k(1 − k)` long, level (no component along the vertical `x` of a rod without
+    /// weight), across the line, and along `x × (goal − start)` for `s > 0`; the other way for
+    /// `s < 0`. Where the straight line has no horizontal across (here: the start and goal
+    /// ends at the same point), there is no such line.
+    #[test]
+    fn a_line_moved_aside_stays_level_and_across() {
+        use crate::rod::Rod;
+        use crate::rod::layout::Layout;
+        use crate::rod::model::{Discretisation, Model};
+        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
+        let layout = Layout::of(&rod, 4);
+        let d = Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        };
+        let model = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let a0 = vec![0.0; model.n()];
+        let seed = |e| super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e);
+        let (start, goal) = (seed([-0.4, 0.5, 0.4]), seed([0.6, 0.4, -0.6]));
+        let b = model.boundary(1.0);
+        let (x0, x1) = (
+            model.evaluate(&start).positions[b],
+            model.evaluate(&goal).positions[b],
+        );
+        let chord: [f64; 3] = std::array::from_fn(|i| x1[i] - x0[i]);
+        // x × chord, computed here.
+        let across = [0.0, -chord[2], chord[1]];
+        for s in [0.3, -0.5] {
+            let line = PoseLine::new(&model, &start, &goal, Detour { lift: 0.0, side: s })
+                .expect("a line");
+            for i in 0..=20 {
+                let k = i as f64 / 20.0;
+                let x = line.position(k);
+                let off: [f64; 3] = std::array::from_fn(|j| x[j] - (x0[j] + k * chord[j]));
+                let len = off.iter().map(|v| v * v).sum::<f64>().sqrt();
+                assert!(
+                    (len - s.abs() * 4.0 * k * (1.0 - k)).abs() < 1e-14,
+                    "k = {k}"
+                );
+                assert!(off[0].abs() < 1e-15, "k = {k}: {off:?}");
+                let along: f64 = (0..3).map(|j| off[j] * chord[j]).sum();
+                assert!(along.abs() < 1e-14, "k = {k}: {along}");
+                let dot: f64 = (0..3).map(|j| off[j] * across[j]).sum();
+                assert!(k == 0.0 || k == 1.0 || dot * s > 0.0, "k = {k}");
+            }
+        }
+        let in_place = PoseLine::new(
+            &model,
+            &start,
+            &start,
+            Detour {
+                lift: 0.0,
+                side: 0.3,
+            },
+        );
+        assert!(in_place.is_none());
     }
 
     /// A 3D end turned from a frame tilted 0.3 rad towards −y to one tilted 0.06 rad towards
@@ -209,7 +355,7 @@ mod tests {
         let (e0, e1) = ([-half, 0.3, 1.5], [half, 0.06, -1.6]);
         let start = super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e0);
         let goal = super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e1);
-        let line = PoseLine::new(&model, &start, &goal, 0.0);
+        let line = PoseLine::new(&model, &start, &goal, lifted(0.0)).expect("a line");
         let m = |e: [f64; 3]| super::quaternion(rotation(e[0], e[1], e[2]));
         let (q0, q1) = (m(e0), m(e1));
         assert_eq!(line.angles(0.0), model.angles_at(&start, 1.0));

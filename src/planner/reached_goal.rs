@@ -192,9 +192,10 @@ impl Planner {
         observer: &mut dyn PlanObserver,
     ) -> Judged {
         let path = self.path_of(result);
-        let mut j = match (route.trajectory, route.lift_over_l) {
-            ("pose_line", Some(lift)) => {
-                self.with_finer_if_dipping(|pl| pl.judge_pose_line(lift, fine, observer))
+        let line = route.line.and_then(|d| self.pose_line(d)).map(Arc::new);
+        let mut j = match (route.trajectory, line) {
+            ("pose_line", Some(line)) => {
+                self.with_finer_if_dipping(|pl| pl.judge_pose_line(&line, fine, observer))
             }
             ("straight_path", _) => {
                 self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer))
@@ -305,7 +306,7 @@ fn routes(reached: &[Reached]) -> Vec<Reached> {
     for r in reached {
         if !out
             .iter()
-            .any(|o| o.trajectory == r.trajectory && o.lift_over_l == r.lift_over_l)
+            .any(|o| o.trajectory == r.trajectory && o.line == r.line)
         {
             out.push(r.clone());
         }
@@ -316,6 +317,12 @@ fn routes(reached: &[Reached]) -> Vec<Reached> {
 #[cfg(test)]
 mod tests {
     use super::super::equilibrium_plan::{EquilibriumPlan, Reached};
+    use super::super::pose_line::Detour;
+
+    /// Lifted by `lift`, not moved aside.
+    fn lifted(lift: f64) -> Option<Detour> {
+        Some(Detour { lift, side: 0.0 })
+    }
 
     /// Equilibria that ended on `a` (one coefficient) along the optimal path's trajectory.
     fn ended_on(a: f64) -> EquilibriumPlan {
@@ -334,12 +341,13 @@ mod tests {
             contact_samples: None,
             trajectory: "optimal_path",
             lift_over_l: None,
+            side_over_l: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: vec![Reached {
                 a: vec![a],
                 trajectory: "optimal_path",
-                lift_over_l: None,
+                line: None,
             }],
         }
     }
@@ -355,9 +363,9 @@ mod tests {
         let mut straight = ended_on(3.0);
         straight.set_trajectory("straight_path", None);
         let mut line = ended_on(4.0);
-        line.set_trajectory("pose_line", Some(0.3));
+        line.set_trajectory("pose_line", lifted(0.3));
         let mut higher = ended_on(5.0);
-        higher.set_trajectory("pose_line", Some(0.5));
+        higher.set_trajectory("pose_line", lifted(0.5));
         for (what, retry) in [
             ("straight", &straight),
             ("line", &line),
@@ -365,10 +373,10 @@ mod tests {
         ] {
             plan.retry_failed_as(what, retry);
         }
-        let got: Vec<(f64, &str, Option<f64>)> = plan
+        let got: Vec<(f64, &str, Option<Detour>)> = plan
             .reached_goals
             .iter()
-            .map(|r| (r.a[0], r.trajectory, r.lift_over_l))
+            .map(|r| (r.a[0], r.trajectory, r.line))
             .collect();
         assert_eq!(
             got,
@@ -376,8 +384,8 @@ mod tests {
                 (1.0, "optimal_path", None),
                 (2.0, "optimal_path", None),
                 (3.0, "straight_path", None),
-                (4.0, "pose_line", Some(0.3)),
-                (5.0, "pose_line", Some(0.5)),
+                (4.0, "pose_line", lifted(0.3)),
+                (5.0, "pose_line", lifted(0.5)),
             ]
         );
         let routes: Vec<f64> = super::routes(&plan.reached_goals)
@@ -387,5 +395,7 @@ mod tests {
         assert_eq!(routes, [1.0, 3.0, 4.0, 5.0]);
         assert_eq!(line.trajectory, "pose_line");
         assert_eq!(line.lift_over_l, Some(0.3));
+        assert_eq!(line.side_over_l, None);
+        assert_eq!(line.pose_line(), lifted(0.3));
     }
 }

@@ -337,12 +337,10 @@ impl PlanResult {
     }
 
     /// Whether the replayed equilibria judged as the plan follow a pose line
-    /// (`equilibrium_plan.trajectory` is `"pose_line"`, [`super::pose_line`]): the lift, if so.
-    pub fn along_pose_line(&self) -> Option<f64> {
-        self.equilibrium_plan
-            .as_ref()
-            .filter(|e| e.trajectory == "pose_line")
-            .and_then(|e| e.lift_over_l)
+    /// (`equilibrium_plan.trajectory` is `"pose_line"`, [`super::pose_line`]): how it leaves
+    /// the straight line, if so.
+    pub fn along_pose_line(&self) -> Option<super::pose_line::Detour> {
+        self.equilibrium_plan.as_ref().and_then(|e| e.pose_line())
     }
 
     /// Whether the replay is not the optimal path's: it followed the straight-line path's end

@@ -244,31 +244,33 @@ impl Planner {
                         "not executable".into()
                     }
                 });
-            // The straight-line path's trajectory, then the pose lines in increasing lift; the
-            // first whose equilibria pass is the plan.
+            // The straight-line path's trajectory, then the pose lines in their order
+            // ([`pose_line::DETOURS`]); the first whose equilibria pass is the plan.
             // Of those that fail, only why is kept (not their replayed shapes).
             let mut found = None;
             let mut failed: Vec<(String, Option<EquilibriumPlan>)> = Vec::new();
-            let along =
-                |pl: &Planner, lift: Option<f64>, observer: &mut dyn PlanObserver| match lift {
-                    None => pl.judge_straight_trajectory(&fine, observer),
-                    Some(h) => pl.judge_pose_line(h, &fine, observer),
-                };
-            let lines = pose_line::LIFTS.map(Some);
-            for lift in std::iter::once(None).chain(lines) {
-                if lift.is_some() && (!self.settings.pose_lines || self.stopped() || self.time_up())
+            // (No line moved aside on a planar rod.)
+            let lines = pose_line::DETOURS
+                .iter()
+                .filter_map(|&d| self.pose_line(d))
+                .map(|l| Some(Arc::new(l)));
+            for line in std::iter::once(None).chain(lines) {
+                if line.is_some() && (!self.settings.pose_lines || self.stopped() || self.time_up())
                 {
                     break;
                 }
-                let s = self.with_finer_if_dipping(|pl| along(pl, lift, observer));
+                let s = self.with_finer_if_dipping(|pl| match &line {
+                    None => pl.judge_straight_trajectory(&fine, observer),
+                    Some(l) => pl.judge_pose_line(l, &fine, observer),
+                });
                 if s.executable {
                     found = Some(s);
                     break;
                 }
-                let what = match lift {
+                let what = match line.as_ref().map(|l| l.detour.describe()) {
                     None => "along the straight path's trajectory".into(),
-                    Some(h) if h > 0.0 => format!("along the end's pose line lifted {h} L"),
-                    Some(_) => "along the end's pose line".into(),
+                    Some(d) if d.is_empty() => "along the end's pose line".into(),
+                    Some(d) => format!("along the end's pose line {d}"),
                 };
                 failed.push((what, s.equilibrium_plan));
             }

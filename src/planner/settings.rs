@@ -114,15 +114,18 @@ pub struct PlanSettings {
     /// first solve's shape, where it converges.
     pub least_energy_ends: bool,
     /// A goal given by its pose alone (no `shape`): where no plan to the goal shape its static
-    /// solve found is executable, but the gripper's motion along the best plan's trajectory
-    /// brings the rod to another equilibrium of the goal pose — every solve of its replay
-    /// converged, stable, clear of the obstacles, nothing snapping — plan again to that
-    /// equilibrium, and report the plan to it where it is executable
+    /// solve found is executable, but the gripper's motion along a trajectory of the search
+    /// (the best plan's, the straight-line path's or a pose line) brings the rod to another
+    /// equilibrium of the goal pose — every solve of its replay converged, stable, clear of
+    /// the obstacles, nothing snapping — plan again to that equilibrium, and report the plan
+    /// to it where it is executable, else that motion's equilibria where they pass
     /// ([`super::PlanResult::reached_goal`]); `false`: only the end solve's goal shape.
     pub reached_goal: bool,
     /// Where neither an optimised path nor the straight-line path executes by its replayed
     /// equilibria, try the equilibria along lines in the end's pose space, lifted against
-    /// gravity by 0, 0.15, 0.3 and 0.5 L mid-way ([`super::pose_line`]); `false`: not.
+    /// gravity by 0, 0.15, 0.3 and 0.5 L mid-way, then on a 3D rod moved aside across the
+    /// straight line by 0.3 and 0.5 L either way ([`super::pose_line::DETOURS`]); `false`:
+    /// not.
     pub pose_lines: bool,
     /// Lift a converged plan that is collision-free but not executable — the quick attempt's
     /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the

@@ -1710,7 +1710,8 @@ fn a_heavy_cable_dragged_across_a_table_follows_a_lifted_pose_line() {
     );
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
-    assert_eq!(r.along_pose_line(), Some(0.5));
+    let lifted = |lift| dlo_planner::planner::pose_line::Detour { lift, side: 0.0 };
+    assert_eq!(r.along_pose_line(), Some(lifted(0.5)));
     let e = r.equilibrium_plan.as_ref().expect("judged equilibria");
     let why = e.optimal_path_not_executable.as_deref().unwrap_or_default();
     assert!(why.contains("did not converge"), "{why}");
@@ -1718,7 +1719,7 @@ fn a_heavy_cable_dragged_across_a_table_follows_a_lifted_pose_line() {
         e.confirmation_deviation_over_l
             .is_some_and(|d| d <= r.replay.tolerance)
     );
-    follows_the_pose_line(&p, &r, 0.5);
+    follows_the_pose_line(&p, &r, 0.5, 0.0);
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
     // Without the lines, no plan executes.
     let (_, off) = planned_with(
@@ -1732,21 +1733,25 @@ fn a_heavy_cable_dragged_across_a_table_follows_a_lifted_pose_line() {
 }
 
 /// Every replayed equilibrium of `r` holds its end on the chord between the start and goal
-/// shapes' ends raised by `lift`·4k(1−k) along x (against gravity in the table family), to
-/// 1e-9, with its end frame the slerp's between theirs, to 1e-9 rad: computed here, not by
-/// the planner's line.
+/// shapes' ends, moved by `4k(1−k)` times `lift` along x (against gravity in the table family)
+/// and `side` along the unit vector of x × chord (horizontal, across it), to 1e-9, with its
+/// end frame the slerp's between theirs, to 1e-9 rad: computed here, not by the planner's line.
 fn follows_the_pose_line(
     p: &dlo_planner::planner::Planner,
     r: &dlo_planner::planner::PlanResult,
     lift: f64,
+    side: f64,
 ) {
-    use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+    use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
     let model = &p.base.model;
     let tip = model.boundary(1.0);
     let (x0, x1) = (
         model.evaluate(&p.start.a).positions[tip],
         model.evaluate(&p.goal.a).positions[tip],
     );
+    let chord = Vector3::from(x1) - Vector3::from(x0);
+    let up = Vector3::x();
+    let offset = up * lift + up.cross(&chord).normalize() * side;
     let q = |a: &[f64]| {
         let m = model.frame_at(a, 1.0);
         UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(Matrix3::from_fn(
@@ -1757,18 +1762,44 @@ fn follows_the_pose_line(
     for step in &r.replay.steps {
         let k = step.k;
         let end = step.positions[tip];
+        let want = Vector3::from(x0) + chord * k + offset * (4.0 * k * (1.0 - k));
         for i in 0..3 {
-            let raised = if i == 0 {
-                lift * 4.0 * k * (1.0 - k)
-            } else {
-                0.0
-            };
-            let want = (1.0 - k) * x0[i] + k * x1[i] + raised;
-            assert!((end[i] - want).abs() <= 1e-9, "k = {k}: {end:?}");
+            assert!((end[i] - want[i]).abs() <= 1e-9, "k = {k}: {end:?}");
         }
         let turn = q0.slerp(&q1, k).angle_to(&q(&step.a));
         assert!(turn <= 1e-9, "k = {k}: {turn} rad from the slerp's frame");
     }
+}
+
+/// The table family's `table_2_11` (seed 2): no optimised path executes, nor the straight
+/// path's equilibria, nor those of the lifted lines tried before; the line moved aside by
+/// −0.3 L (across the straight line, horizontally) is the plan. Checked: its equilibria follow
+/// that line (computed here), are held on the trajectory, clear on a grid four times finer in
+/// s, and end on the goal shape; the report gives the move aside and why the optimal path
+/// does not execute.
+#[test]
+fn a_heavy_cable_dragged_across_a_table_follows_a_line_moved_aside() {
+    let text = nth_problem(table_problem, 2, 11);
+    let (p, r) = planned_with(
+        &text,
+        "table_2_11.json",
+        &serde_json::json!({}),
+        &mut Logged::default(),
+    );
+    assert!(r.verdict().is_executable(), "{}", r.verdict());
+    assert_eq!(r.executed_path(), Some("equilibria"));
+    let aside = dlo_planner::planner::pose_line::Detour {
+        lift: 0.0,
+        side: -0.3,
+    };
+    assert_eq!(r.along_pose_line(), Some(aside));
+    let e = r.equilibrium_plan.as_ref().expect("judged equilibria");
+    assert_eq!(e.side_over_l, Some(-0.3));
+    assert!(e.optimal_path_not_executable.is_some());
+    assert!(r.reached_goal.is_none());
+    assert!(r.replay.end_deviation_over_l <= r.replay.tolerance);
+    follows_the_pose_line(&p, &r, 0.0, -0.3);
+    held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
 /// The table family's `table_1_21` (seed 1): no optimised path executes, nor its equilibria;
@@ -1791,7 +1822,11 @@ fn a_pose_line_that_reaches_another_goal_equilibrium_is_the_plan() {
     );
     assert!(r.verdict().is_executable(), "{}", r.verdict());
     assert_eq!(r.executed_path(), Some("equilibria"));
-    assert_eq!(r.along_pose_line(), Some(0.0));
+    let unlifted = dlo_planner::planner::pose_line::Detour {
+        lift: 0.0,
+        side: 0.0,
+    };
+    assert_eq!(r.along_pose_line(), Some(unlifted));
     let g = r.reached_goal.as_ref().expect("a reached goal");
     assert!(g.replan_failed.is_some());
     let tolerance = p.settings.coincide_tolerance;
@@ -1808,7 +1843,7 @@ fn a_pose_line_that_reaches_another_goal_equilibrium_is_the_plan() {
         .map(|(a, b)| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt())
         .fold(0.0, f64::max);
     assert!(apart <= tolerance * model.rod.length, "{apart}");
-    follows_the_pose_line(&p, &r, 0.0);
+    follows_the_pose_line(&p, &r, 0.0, 0.0);
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
     let (_, off) = planned_with(
         &text,

@@ -455,12 +455,11 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         match (r.executed_path, p.along_pose_line()) {
             (Some("equilibria"), _) if p.along_straight_trajectory() =>
                 " by the replayed equilibria along the straight-line path's trajectory".into(),
-            (Some("equilibria"), Some(h)) => format!(
+            (Some("equilibria"), Some(d)) => format!(
                 " by the replayed equilibria along a line in the end's pose space{}",
-                if h > 0.0 {
-                    format!(" lifted {h} L mid-way")
-                } else {
-                    String::new()
+                match d.describe() {
+                    d if d.is_empty() => d,
+                    d => format!(" {d} mid-way"),
                 }
             ),
             (Some("equilibria"), None) =>
@@ -502,17 +501,11 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
             g.energy, g.distance_over_l, g.solved_energy, g.first_plan
         );
         if let Some(why) = &g.replan_failed {
-            let along = match p
-                .equilibrium_plan
-                .as_ref()
-                .map(|e| (e.trajectory, e.lift_over_l))
-            {
-                Some(("pose_line", Some(h))) if h > 0.0 => {
-                    format!("along the end's pose line lifted {h} L")
-                }
-                Some(("pose_line", _)) => "along the end's pose line".into(),
-                Some(("straight_path", _)) => "along the straight path's trajectory".into(),
-                _ => "along the first plan's trajectory".into(),
+            let along = match (p.along_pose_line(), p.along_straight_trajectory()) {
+                (Some(d), _) if d.describe().is_empty() => "along the end's pose line".into(),
+                (Some(d), _) => format!("along the end's pose line {}", d.describe()),
+                (None, true) => "along the straight path's trajectory".into(),
+                (None, false) => "along the first plan's trajectory".into(),
             };
             let _ = writeln!(
                 o,
@@ -659,11 +652,13 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     }
     if let Some(e) = &p.equilibrium_plan {
         if let Some(why) = &e.optimal_path_not_executable {
-            let follows = match e.lift_over_l {
-                Some(h) if h > 0.0 => format!(
-                    "a line in its pose space, lifted {h} L mid-way against gravity; the replay is that line's"
+            let follows = match e.pose_line().map(|d| d.describe()) {
+                Some(d) if d.is_empty() => {
+                    "a line in its pose space; the replay is that line's".into()
+                }
+                Some(d) => format!(
+                    "a line in its pose space, {d} mid-way (lifted against gravity, aside across the line); the replay is that line's"
                 ),
-                Some(_) => "a line in its pose space; the replay is that line's".into(),
                 None => "the straight-line path's end poses".into(),
             };
             let _ = writeln!(
