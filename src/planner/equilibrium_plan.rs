@@ -383,7 +383,7 @@ impl Planner {
         }
         let opts = ReplayOptions {
             steps: 2 * self.settings.replay_steps,
-            early_stop: EarlyStop::Unconverged,
+            early_stop: EarlyStop::Failure,
             ..self.settings.replay()
         };
         let second = replay_driven(

@@ -141,7 +141,8 @@ impl Planner {
 
     /// [`Self::judge`] of `path(z)`, executable as it stands when it coincides with its replay
     /// and `planned` (collision-free and converged); its replay ends early by `early_stop`
-    /// (the replays of the equilibria's retries end at a solve that does not converge).
+    /// (the replays of the equilibria's retries end at a solve that does not converge or a
+    /// snap-through).
     pub(super) fn judge_path(
         &self,
         path: &DeformationPath,
@@ -193,7 +194,7 @@ impl Planner {
                            rep: &mut Replay,
                            shapes: &mut RecordedShapes| {
                 let mut rec = Recorder::new(observer);
-                let again = pl.replay_under(held, path, z, EarlyStop::Unconverged, &mut rec);
+                let again = pl.replay_under(held, path, z, EarlyStop::Failure, &mut rec);
                 let plan = pl.equilibrium_plan(held, path, z, &again, fine, &mut rec);
                 if plan.executable {
                     *ep = equilibrium_plan::EquilibriumPlan {

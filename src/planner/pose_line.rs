@@ -230,8 +230,7 @@ impl Planner {
         };
         let path = self.path();
         let z = vec![0.0; path.n_vars()];
-        let mut judged =
-            driven.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        let mut judged = driven.judge_path(&path, &z, false, EarlyStop::Failure, fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
             e.set_trajectory("pose_line", Some(line.detour));
         }

@@ -143,6 +143,9 @@ pub enum EarlyStop {
     /// A static solve that does not converge (whether the replayed equilibria are a plan: they
     /// are not once one solve fails).
     Unconverged,
+    /// That, or a snap-through (whether the replayed equilibria are a plan: they are not once
+    /// the rod snaps).
+    Failure,
     /// That, a snap-through, or a shape farther from the path's than the tolerance (whether the
     /// replay coincides with the path).
     Departure,
@@ -390,6 +393,7 @@ pub fn replay_driven(
         match opts.early_stop {
             EarlyStop::Never => false,
             EarlyStop::Unconverged => !last.converged,
+            EarlyStop::Failure => !last.converged || !snaps.is_empty(),
             EarlyStop::Departure => {
                 !last.converged || !snaps.is_empty() || last.deviation > opts.tolerance * l
             }

@@ -162,7 +162,7 @@ impl Planner {
     ) -> Judged {
         let path = self.path();
         let z = vec![0.0; path.n_vars()];
-        let mut judged = self.judge_path(&path, &z, false, EarlyStop::Unconverged, fine, observer);
+        let mut judged = self.judge_path(&path, &z, false, EarlyStop::Failure, fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
             e.set_trajectory("straight_path", None);
         }

@@ -238,10 +238,10 @@ fn plan_beats_hand_made_collision_free_paths() {
 }
 
 /// A replay that only decides a question ends at its answer: on the paper's straight path
-/// (which runs through the block, so the replayed equilibria leave it), the replay that stops
-/// at a departure, and the one that stops at a solve that does not converge, are the full
-/// replay's first steps bit for bit, up to and including the first step that answers, and
-/// neither coincides when it stopped.
+/// (which runs through the block, so the replayed equilibria leave it), the replays that stop
+/// at a departure, at a solve that does not converge, and at that or a snap-through, are the
+/// full replay's first steps bit for bit, up to and including the first step that answers,
+/// and none coincides when it stopped.
 #[test]
 fn a_replay_stopped_early_is_the_start_of_the_full_replay() {
     use dlo_planner::planner::replay::EarlyStop;
@@ -259,9 +259,14 @@ fn a_replay_stopped_early_is_the_start_of_the_full_replay() {
         full.steps.len()
     );
     let first_unconverged = full.steps.iter().position(|s| !s.converged);
+    let first_failure = full
+        .steps
+        .iter()
+        .position(|s| !s.converged || full.snaps.contains(&s.k));
     for (mode, answer) in [
         (EarlyStop::Departure, first_departure),
         (EarlyStop::Unconverged, first_unconverged),
+        (EarlyStop::Failure, first_failure),
     ] {
         let early = run(mode);
         let n = answer.map_or(full.steps.len(), |i| i + 1);
