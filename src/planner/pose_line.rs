@@ -247,6 +247,20 @@ mod tests {
         Detour { lift, side: 0.0 }
     }
 
+    /// A 3D rod without weight (L = 1, Rf = Rt = 1), no obstacles.
+    fn spatial_model() -> crate::rod::model::Model {
+        use crate::rod::Rod;
+        use crate::rod::layout::Layout;
+        use crate::rod::model::{Discretisation, Model};
+        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
+        let layout = Layout::of(&rod, 4);
+        let d = Discretisation {
+            panels: 8,
+            gauss_points: 4,
+        };
+        Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0])
+    }
+
     /// The line starts and ends on the end poses of its shapes (angles as the shapes have
     /// them), rises by the lift mid-way, and turns along the shortest rotation: its frames at
     /// `k` and the slerp's agree.
@@ -279,16 +293,7 @@ mod tests {
     /// ends at the same point), there is no such line.
     #[test]
     fn a_line_moved_aside_stays_level_and_across() {
-        use crate::rod::Rod;
-        use crate::rod::layout::Layout;
-        use crate::rod::model::{Discretisation, Model};
-        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
-        let layout = Layout::of(&rod, 4);
-        let d = Discretisation {
-            panels: 8,
-            gauss_points: 4,
-        };
-        let model = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let model = spatial_model();
         let a0 = vec![0.0; model.n()];
         let seed = |e| super::super::endpoints::seed_towards(&model, &a0, [0.0; 3], false, e);
         let (start, goal) = (seed([-0.4, 0.5, 0.4]), seed([0.6, 0.4, -0.6]));
@@ -338,17 +343,8 @@ mod tests {
     /// `φ + ψ` only.
     #[test]
     fn a_spatial_pose_line_turns_along_the_slerp_with_continuous_angles() {
-        use crate::rod::Rod;
         use crate::rod::kinematics::rotation;
-        use crate::rod::layout::Layout;
-        use crate::rod::model::{Discretisation, Model};
-        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
-        let layout = Layout::of(&rod, 4);
-        let d = Discretisation {
-            panels: 8,
-            gauss_points: 4,
-        };
-        let model = Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0]);
+        let model = spatial_model();
         let a0 = vec![0.0; model.n()];
         let half = std::f64::consts::FRAC_PI_2;
         let (e0, e1) = ([-half, 0.3, 1.5], [half, 0.06, -1.6]);

@@ -21,13 +21,13 @@
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::equilibrium_plan::Reached;
 use super::judge::Judged;
-use super::observer::{PathKind, PlanObserver, RecordedShapes, Recorder, ShapeRecord, flush};
+use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
 use super::path::DeformationPath;
 use super::replay::{EarlyStop, max_distance};
 use super::result::{PlanResult, PlanStatus, PlanVerdict, ReachedGoal};
 use super::trajectory::Trajectory;
 use super::verify::fine_model;
-use super::{Planner, clearance, endpoints::EndPose};
+use super::{Planner, endpoints::EndPose};
 use crate::rod::kinematics::Shape;
 use crate::rod::model::Model;
 use crate::statics::{SolveStatus, StaticSolution};
@@ -115,21 +115,7 @@ impl Planner {
             if this.shape == replanned_to {
                 flush(&searched.goal_shape(), model, observer);
             } else {
-                let sh = model.evaluate(&sol.a);
-                observer.shape(
-                    model,
-                    &ShapeRecord {
-                        kind: PathKind::Endpoint,
-                        k: 1.0,
-                        a: &sol.a,
-                        energy: sol.energy,
-                        clearance: clearance(&self.base, &sh.positions),
-                        deviation: None,
-                        stable: sol.stable,
-                        reactions: &sol.reactions,
-                        violation: Some(sol.max_violation),
-                    },
-                );
+                self.end_shape(1.0, &sol, observer);
             }
             flush(&j.shapes, model, observer);
             this.first_plan_seconds = reached.first_plan_seconds;

@@ -124,26 +124,37 @@ impl Planner {
         self.towards_reached_goal(result, replayed, observer)
     }
 
+    /// Tells `observer` of the end shape `sol` at `k` (0: the start, 1: the goal).
+    pub(super) fn end_shape(
+        &self,
+        k: f64,
+        sol: &crate::statics::StaticSolution,
+        observer: &mut dyn PlanObserver,
+    ) {
+        let model = &self.base.model;
+        let sh = model.evaluate(&sol.a);
+        observer.shape(
+            model,
+            &ShapeRecord {
+                kind: PathKind::Endpoint,
+                k,
+                a: &sol.a,
+                energy: sol.energy,
+                clearance: clearance(&self.base, &sh.positions),
+                deviation: None,
+                stable: sol.stable,
+                reactions: &sol.reactions,
+                violation: Some(sol.max_violation),
+            },
+        );
+    }
+
     /// The search of [`Planner::run`]: the plan, and its replay's shapes, not yet logged.
     pub(super) fn search(&self, observer: &mut dyn PlanObserver) -> (PlanResult, RecordedShapes) {
         let model = &self.base.model;
         observer.phase("endpoints");
         for (k, sol) in [(0.0, &self.start), (1.0, &self.goal)] {
-            let sh = model.evaluate(&sol.a);
-            observer.shape(
-                model,
-                &ShapeRecord {
-                    kind: PathKind::Endpoint,
-                    k,
-                    a: &sol.a,
-                    energy: sol.energy,
-                    clearance: clearance(&self.base, &sh.positions),
-                    deviation: None,
-                    stable: sol.stable,
-                    reactions: &sol.reactions,
-                    violation: Some(sol.max_violation),
-                },
-            );
+            self.end_shape(k, sol, observer);
         }
         let t0 = std::time::Instant::now();
         let path = self.path();
