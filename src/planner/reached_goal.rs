@@ -106,7 +106,9 @@ impl Planner {
                 ends_on: Some(Arc::new(model.evaluate(&this.shape).positions)),
                 ..self.clone()
             };
-            let j = accepting.judge_route(&route, &result, &fine, observer);
+            let Some(j) = accepting.judge_route(&route, &result, &fine, observer) else {
+                continue;
+            };
             result.timing_s.replay += j.seconds;
             if !j.executable {
                 continue;
@@ -169,28 +171,29 @@ impl Planner {
 
     /// The equilibria along `route`'s trajectory (that of `result`'s optimal path, of the
     /// straight-line path or a pose line), judged again by this planner, with the optimal
-    /// path's shapes recorded as those of `result`'s path.
+    /// path's shapes recorded as those of `result`'s path (`None`: a pose line there is not,
+    /// [`Self::pose_line`]).
     fn judge_route(
         &self,
         route: &Reached,
         result: &PlanResult,
         fine: &Model,
         observer: &mut dyn PlanObserver,
-    ) -> Judged {
+    ) -> Option<Judged> {
         let path = self.path_of(result);
-        let line = route.line.and_then(|d| self.pose_line(d)).map(Arc::new);
-        let mut j = match (route.trajectory, line) {
-            ("pose_line", Some(line)) => {
+        let mut j = match route.trajectory {
+            "pose_line" => {
+                let line = Arc::new(self.pose_line(route.line?)?);
                 self.with_finer_if_dipping(|pl| pl.judge_pose_line(&line, fine, observer))
             }
-            ("straight_path", _) => {
+            "straight_path" => {
                 self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer))
             }
             _ => {
                 let planned = result.status == PlanStatus::Planned;
-                return self.with_finer_if_dipping(|pl| {
+                return Some(self.with_finer_if_dipping(|pl| {
                     pl.judge_path(&path, &result.z, planned, EarlyStop::Never, fine, observer)
-                });
+                }));
             }
         };
         // (A replay of another trajectory records that trajectory's shapes as its optimal ones.)
@@ -200,7 +203,7 @@ impl Planner {
             let (e, c) = self.path_shape(&path, &result.z, k, &mut a, &mut sh);
             (a.clone(), e, c)
         });
-        j
+        Some(j)
     }
 
     /// The planner with the goal shape the gripper's motion reached in `result`'s replay, and

@@ -652,13 +652,16 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
     }
     if let Some(e) = &p.equilibrium_plan {
         if let Some(why) = &e.optimal_path_not_executable {
-            let follows = match e.pose_line().map(|d| d.describe()) {
-                Some(d) if d.is_empty() => {
-                    "a line in its pose space; the replay is that line's".into()
-                }
-                Some(d) => format!(
-                    "a line in its pose space, {d} mid-way (lifted against gravity, aside across the line); the replay is that line's"
+            let follows = match e.pose_line() {
+                Some(d) if d.side != 0.0 => format!(
+                    "a line in its pose space, {} mid-way, horizontally across the straight line; the replay is that line's",
+                    d.describe()
                 ),
+                Some(d) if d.lift != 0.0 => format!(
+                    "a line in its pose space, {} mid-way against gravity; the replay is that line's",
+                    d.describe()
+                ),
+                Some(_) => "a line in its pose space; the replay is that line's".into(),
                 None => "the straight-line path's end poses".into(),
             };
             let _ = writeln!(
