@@ -381,12 +381,13 @@ pub fn solve_end(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use crate::rod::Rod;
     use crate::rod::layout::Layout;
     use crate::rod::model::{Discretisation, Model};
 
-    fn model(rod: Rod) -> Model {
+    /// The model of `rod` on its default layout, 8 panels of 4 Gauss points, no obstacles.
+    pub(in crate::planner) fn model(rod: Rod) -> Model {
         let layout = Layout::of(&rod, 4);
         model_with(rod, layout)
     }

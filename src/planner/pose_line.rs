@@ -45,6 +45,15 @@ impl Detour {
             _ => String::new(),
         }
     }
+
+    /// The line's name in a report: `"the end's pose line"`, followed by
+    /// [`Detour::describe`] where it leaves the straight line.
+    pub fn line_name(&self) -> String {
+        match self.describe() {
+            d if d.is_empty() => "the end's pose line".into(),
+            d => format!("the end's pose line {d}"),
+        }
+    }
 }
 
 /// The pose lines tried, in order: lifted by 0, 0.15, 0.3 and 0.5 L, then, on a 3D rod, moved
@@ -249,16 +258,8 @@ mod tests {
 
     /// A 3D rod without weight (L = 1, Rf = Rt = 1), no obstacles.
     fn spatial_model() -> crate::rod::model::Model {
-        use crate::rod::Rod;
-        use crate::rod::layout::Layout;
-        use crate::rod::model::{Discretisation, Model};
-        let rod = Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
-        let layout = Layout::of(&rod, 4);
-        let d = Discretisation {
-            panels: 8,
-            gauss_points: 4,
-        };
-        Model::new(rod, layout, d, [0.0; 3], Vec::new(), &[0.0, 1.0])
+        let rod = crate::rod::Rod::uniform(1.0, 1.0).with_torsional_rigidity(1.0);
+        super::super::endpoints::tests::model(rod)
     }
 
     /// The line starts and ends on the end poses of its shapes (angles as the shapes have

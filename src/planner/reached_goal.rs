@@ -61,7 +61,7 @@ impl Planner {
         observer: &mut dyn PlanObserver,
     ) -> PlanResult {
         let model = &self.base.model;
-        let Some((planner, mut reached)) = self.reached_goal_planner(&result) else {
+        let Some((planner, mut reached, from)) = self.reached_goal_planner(&result) else {
             flush(&replayed, model, observer);
             return result;
         };
@@ -88,7 +88,6 @@ impl Planner {
         // The equilibria along each trajectory that reached another equilibrium of the goal
         // pose, in the order they were judged, judged again with that end accepted (every
         // other check as before): the first that passes is the plan.
-        let replanned_to = reached.shape.clone();
         let tried = result
             .equilibrium_plan
             .as_ref()
@@ -99,7 +98,14 @@ impl Planner {
             if self.stopped() || self.time_up() {
                 break;
             }
-            let Some((mut this, sol)) = self.reached_equilibrium(&route.a, &result) else {
+            // (The equilibrium planned to again is solved already: its planner's goal.)
+            let replanned = route.a == from;
+            let solved = if replanned {
+                Some((reached.clone(), planner.goal.clone()))
+            } else {
+                self.reached_equilibrium(&route.a, &result)
+            };
+            let Some((mut this, sol)) = solved else {
                 continue;
             };
             let accepting = Planner {
@@ -114,14 +120,14 @@ impl Planner {
                 continue;
             }
             // The goal shape the plan ends on: the second search's, or this one.
-            if this.shape == replanned_to {
+            if replanned {
                 flush(&searched.goal_shape(), model, observer);
             } else {
                 self.end_shape(1.0, &sol, observer);
             }
             flush(&j.shapes, model, observer);
             this.first_plan_seconds = reached.first_plan_seconds;
-            this.replan_failed = Some(if this.shape == replanned_to {
+            this.replan_failed = Some(if replanned {
                 again.verdict().to_string()
             } else {
                 format!(
@@ -212,8 +218,12 @@ impl Planner {
     /// stop or time limit, whose replayed equilibria (along the optimal path's trajectory, or
     /// the straight-line path's or a pose line's tried after it) converge, stay stable, never
     /// snap and keep clear of the obstacles but end on another equilibrium of the goal pose:
-    /// the first such equilibrium [`Self::reached_equilibrium`] accepts.
-    fn reached_goal_planner(&self, result: &PlanResult) -> Option<(Planner, ReachedGoal)> {
+    /// the first such equilibrium [`Self::reached_equilibrium`] accepts, with the replay's
+    /// last shape it was solved from.
+    fn reached_goal_planner(
+        &self,
+        result: &PlanResult,
+    ) -> Option<(Planner, ReachedGoal, Vec<f64>)> {
         if !(self.settings.reached_goal && self.goal_by_pose)
             || result.verdict().is_executable()
             || result.verdict() == PlanVerdict::Interrupted
@@ -225,14 +235,14 @@ impl Planner {
             return None;
         }
         let ep = result.equilibrium_plan.as_ref()?;
-        let reached = ep
-            .reached_goals
-            .iter()
-            .find_map(|r| self.reached_equilibrium(&r.a, result))?;
+        let (reached, goal, from) = ep.reached_goals.iter().find_map(|r| {
+            self.reached_equilibrium(&r.a, result)
+                .map(|(reached, goal)| (reached, goal, r.a.clone()))
+        })?;
         let mut planner = self.clone();
-        planner.goal = reached.1;
+        planner.goal = goal;
         planner.goal_by_pose = false;
-        Some((planner, reached.0))
+        Some((planner, reached, from))
     }
 
     /// The equilibrium `a`, the last shape of replayed equilibria of `result`, solved again at

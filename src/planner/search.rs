@@ -278,10 +278,9 @@ impl Planner {
                     found = Some(s);
                     break;
                 }
-                let what = match line.as_ref().map(|l| l.detour.describe()) {
+                let what = match &line {
                     None => "along the straight path's trajectory".into(),
-                    Some(d) if d.is_empty() => "along the end's pose line".into(),
-                    Some(d) => format!("along the end's pose line {d}"),
+                    Some(l) => format!("along {}", l.detour.line_name()),
                 };
                 failed.push((what, s.equilibrium_plan));
             }

@@ -502,8 +502,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         );
         if let Some(why) = &g.replan_failed {
             let along = match (p.along_pose_line(), p.along_straight_trajectory()) {
-                (Some(d), _) if d.describe().is_empty() => "along the end's pose line".into(),
-                (Some(d), _) => format!("along the end's pose line {}", d.describe()),
+                (Some(d), _) => format!("along {}", d.line_name()),
                 (None, true) => "along the straight path's trajectory".into(),
                 (None, false) => "along the first plan's trajectory".into(),
             };
