@@ -329,6 +329,9 @@ pub struct Outcome {
     /// Of those, along a line in the end's pose space (neither an optimised path nor the
     /// straight-line path's trajectory executable): how it leaves the straight line.
     pub by_pose_line: Option<dlo_planner::planner::pose_line::Detour>,
+    /// Along an optimised pose line: the largest energy of the equilibria along the line as it
+    /// was, and along the optimised one.
+    pub pose_optimised: Option<[f64; 2]>,
     /// The plan ends on another equilibrium of the goal pose than its static solve's, which
     /// the gripper's motion reached (`PlanResult::reached_goal`).
     pub reached_goal: bool,
@@ -536,6 +539,11 @@ pub fn run(
         by_equilibria: executed == Some("equilibria"),
         by_straight: executed.is_some() && along_straight,
         by_pose_line: r.along_pose_line().filter(|_| executed.is_some()),
+        pose_optimised: r
+            .equilibrium_plan
+            .as_ref()
+            .filter(|_| executed.is_some())
+            .and_then(|e| e.pose_line_u_max.map(|before| [before, e.u_max])),
         reached_goal: r.reached_goal.is_some(),
         reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned()),
         why_not: executed.is_none().then(|| {
@@ -794,12 +802,15 @@ fn main() {
                         );
                         if let Some(d) = o.by_pose_line {
                             eprintln!(
-                                "{:16} executable along a line in the end's pose space {}",
+                                "{:16} executable along a line in the end's pose space {}{}",
                                 o.name,
                                 match d.describe() {
                                     d if d.is_empty() => "lifted 0 L".to_string(),
                                     d => d,
-                                }
+                                },
+                                o.pose_optimised.map_or(String::new(), |[a, b]| format!(
+                                    ", optimised: U_max {a:.4} -> {b:.4}"
+                                ))
                             );
                         }
                         if o.reached_not_replanned {

@@ -83,6 +83,15 @@ pub struct EquilibriumPlan {
     /// [`super::pose_line::Detour`]). Absent on lines not moved aside.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub side_over_l: Option<f64>,
+    /// Along an optimised pose line ([`super::pose_optimisation`]): the terms added to the
+    /// end's position, the `m`-th times `k^(m+1) (1 − k)` (case units, case frame). Absent on
+    /// a line as it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose_terms: Option<Vec<[f64; 3]>>,
+    /// Along an optimised pose line: the largest energy of the equilibria along the line as it
+    /// was (case units), against this plan's `u_max`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose_line_u_max: Option<f64>,
     /// Along another trajectory than the optimal path's: why the optimal path was not
     /// executable, as it stands or by its equilibria (`None` otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -350,6 +359,8 @@ impl Planner {
             trajectory: "optimal_path",
             lift_over_l: None,
             side_over_l: None,
+            pose_terms: None,
+            pose_line_u_max: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: Vec::new(),

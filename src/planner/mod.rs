@@ -15,6 +15,7 @@ pub mod observer;
 pub mod orientation;
 pub mod path;
 pub mod pose_line;
+pub mod pose_optimisation;
 mod reached_goal;
 pub mod replay;
 pub mod result;

@@ -341,6 +341,8 @@ mod tests {
             trajectory: "optimal_path",
             lift_over_l: None,
             side_over_l: None,
+            pose_terms: None,
+            pose_line_u_max: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: vec![Reached {

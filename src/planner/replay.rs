@@ -177,7 +177,7 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
 /// With `stiff_retry` (the replay's steps), a solve that does not converge runs once more from
 /// the same start with a hundred times the starting penalty. The tracking rounds' marches do
 /// without: their equilibria are targets, and the optimiser's path follows them.
-fn solve_held(
+pub(super) fn solve_held(
     base: &StaticProblem,
     from: &StaticSolution,
     pose: &EndPose,

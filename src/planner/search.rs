@@ -275,7 +275,10 @@ impl Planner {
                     Some(l) => pl.judge_pose_line(l, &fine, observer),
                 });
                 if s.executable {
-                    found = Some(s);
+                    found = Some(match &line {
+                        Some(l) => self.optimised_pose_line(l, s, &fine, observer),
+                        None => s,
+                    });
                     break;
                 }
                 let what = match &line {

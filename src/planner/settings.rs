@@ -127,6 +127,11 @@ pub struct PlanSettings {
     /// straight line by 0.3 and 0.5 L either way ([`super::pose_line::DETOURS`]); `false`:
     /// not.
     pub pose_lines: bool,
+    /// Where the plan runs along a pose line, optimise terms on the end's position along it
+    /// that lower the peak energy of the equilibria the gripper passes through, and take the
+    /// optimised line where its equilibria are a plan with a lower peak
+    /// ([`super::pose_optimisation`]); `false`: the line as it is.
+    pub pose_optimisation: bool,
     /// Lift a converged plan that is collision-free but not executable — the quick attempt's
     /// where it attains the lower bound on `U_max`, the case's own wherever it peaks — to the
     /// first fallback count's path terms and run equilibrium tracking on it again
@@ -210,6 +215,7 @@ impl Default for PlanSettings {
             least_energy_ends: false,
             reached_goal: true,
             pose_lines: true,
+            pose_optimisation: true,
             lift: true,
             time_limit: None,
         }

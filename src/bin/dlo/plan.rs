@@ -663,6 +663,17 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 Some(_) => "a line in its pose space; the replay is that line's".into(),
                 None => "the straight-line path's end poses".into(),
             };
+            // An optimised line ([`dlo_planner::planner::pose_optimisation`]).
+            let follows = match e.pose_line_u_max {
+                Some(u) => follows.replacen(
+                    "; the replay",
+                    &format!(
+                        ", its positions optimised (along the line itself the equilibria peak at U_max {u:.6e}); the replay"
+                    ),
+                    1,
+                ),
+                None => follows,
+            };
             let _ = writeln!(
                 o,
                 "  the optimal path is not executable ({why}); the gripper follows {follows}"
