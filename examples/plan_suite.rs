@@ -329,8 +329,8 @@ pub struct Outcome {
     /// Of those, along a line in the end's pose space (neither an optimised path nor the
     /// straight-line path's trajectory executable): how it leaves the straight line.
     pub by_pose_line: Option<dlo_planner::planner::pose_line::Detour>,
-    /// Along an optimised pose line: the largest energy of the equilibria along the line as it
-    /// was, and along the optimised one.
+    /// Along a course optimised in the end's pose space: the largest energy of the equilibria
+    /// along the course as it was, and along the optimised one.
     pub pose_optimised: Option<[f64; 2]>,
     /// The plan ends on another equilibrium of the goal pose than its static solve's, which
     /// the gripper's motion reached (`PlanResult::reached_goal`).
@@ -811,6 +811,17 @@ fn main() {
                                 o.pose_optimised.map_or(String::new(), |[a, b]| format!(
                                     ", optimised: U_max {a:.4} -> {b:.4}"
                                 ))
+                            );
+                        }
+                        if let (None, Some([a, b])) = (o.by_pose_line, o.pose_optimised) {
+                            eprintln!(
+                                "{:16} executable along the {} end poses optimised in the end's pose space: U_max {a:.4} -> {b:.4}",
+                                o.name,
+                                if o.by_straight {
+                                    "straight path's"
+                                } else {
+                                    "optimal path's"
+                                }
                             );
                         }
                         if o.reached_not_replanned {

@@ -6,6 +6,7 @@
 
 mod clear_samples;
 pub mod contact_samples;
+pub mod end_course;
 mod end_shapes;
 pub mod endpoints;
 pub mod equilibrium_plan;
@@ -41,7 +42,7 @@ use end_shapes::{end_grid, end_shape, held_frame};
 pub use endpoints::End;
 use minimax::MinimaxProblem;
 use observer::PlanObserver;
-pub use settings::{Optimiser, PlanSettings, Workspace};
+pub use settings::{Optimiser, PlanSettings, PoseOptimisation, Workspace};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -203,7 +204,7 @@ pub struct Planner {
     ends_on: Option<Arc<Vec<[f64; 3]>>>,
     /// The pose line the replays hold the end on instead of the end poses of the path they
     /// replay: set on the copy that judges the equilibria along it ([`pose_line`]).
-    drive: Option<Arc<pose_line::PoseLine>>,
+    drive: Option<Arc<end_course::EndCourse>>,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).
     workers: workers::Workers,
@@ -635,7 +636,7 @@ impl Planner {
         for j in 0..nk {
             let k = j as f64 / (nk - 1) as f64;
             let x = match &self.drive {
-                Some(line) => line.position(k),
+                Some(course) => course.pose_at(model, k).0,
                 None => {
                     path.shape_at(z, k, &mut a);
                     model.evaluate_into(&a, &mut shape);

@@ -15,6 +15,7 @@
 //! [`DETOURS`], and the first that passes is the plan.
 
 use super::Planner;
+use super::end_course::EndCourse;
 use super::endpoints::EndPose;
 use super::judge::Judged;
 use super::observer::PlanObserver;
@@ -107,9 +108,6 @@ pub struct PoseLine {
     offset: [f64; 3],
     /// How it leaves the straight line.
     pub detour: Detour,
-    /// Terms added to the position, the `m`-th times `k^(m+1) (1 − k)` (units of L; empty
-    /// unless optimised, [`super::pose_optimisation`]).
-    terms: Vec<[f64; 3]>,
     turn: Turn,
 }
 
@@ -189,38 +187,14 @@ impl PoseLine {
             to,
             offset: std::array::from_fn(|i| detour.lift * up[i] + detour.side * side[i]),
             detour,
-            terms: Vec::new(),
             turn,
         })
-    }
-
-    /// This line with the position terms `terms` (the `m`-th times `k^(m+1) (1 − k)`, units
-    /// of L) in place of its own.
-    pub fn with_terms(&self, terms: Vec<[f64; 3]>) -> PoseLine {
-        PoseLine {
-            terms,
-            ..self.clone()
-        }
-    }
-
-    /// The position terms (see [`Self::with_terms`]; empty on a line not optimised).
-    pub fn terms(&self) -> &[[f64; 3]] {
-        &self.terms
     }
 
     /// The end's position at `k` (units of L).
     pub fn position(&self, k: f64) -> [f64; 3] {
         let h = 4.0 * k * (1.0 - k);
-        let mut x: [f64; 3] =
-            std::array::from_fn(|i| (1.0 - k) * self.from[i] + k * self.to[i] + h * self.offset[i]);
-        let mut b = 1.0 - k;
-        for t in &self.terms {
-            b *= k;
-            for i in 0..3 {
-                x[i] += b * t[i];
-            }
-        }
-        x
+        std::array::from_fn(|i| (1.0 - k) * self.from[i] + k * self.to[i] + h * self.offset[i])
     }
 
     /// The end's Euler angles at `k` (`[0, θ, 0]` on a planar rod).
@@ -261,7 +235,7 @@ impl Planner {
         observer: &mut dyn PlanObserver,
     ) -> Judged {
         let driven = Planner {
-            drive: Some(line.clone()),
+            drive: Some(Arc::new(EndCourse::line((**line).clone()))),
             ..self.clone()
         };
         let path = self.path();

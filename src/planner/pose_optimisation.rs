@@ -1,36 +1,44 @@
-//! The pose line optimised: where the equilibria along a pose line are the plan, the end's
-//! positions along it are moved by polynomial terms that lower the peak energy of the
-//! equilibria the gripper passes through.
+//! The end's course optimised in its own pose space: where the plan is the equilibria along
+//! a course of the controlled end — the optimal path's end poses (seeded by the
+//! coefficient-space plan, paper §7), the straight-line path's, or a pose line — its positions
+//! are moved by polynomial terms that lower the peak energy of the equilibria the gripper
+//! passes through.
 //!
-//! The line's position gets `Σ_m c_m k^(m+1) (1 − k)` (`m = 0, 1`, each `c_m` a vector in the
-//! layout's position components; units of L): zero at both ends, as the paper's path terms are
-//! (§7.1). Every shape along it is the equilibrium its end pose produces, marched from the
-//! start along `k` as the replay does, so the plan coincides with its replay by construction.
-//! The objective is a smoothed maximum (log-sum-exp) of those equilibria's energies `U_j`,
-//! plus a small tie-breaking term on how far the end's velocity leaves the line's,
-//! `w ∫ |Σ c_m b_m'(k)|² dk` (`w` a hundredth of the larger end energy per L²), which keeps
-//! the gripper on the shorter of routes of nearly equal peak.
+//! The course's position gets `Σ_m c_m k^(m+1) (1 − k)` (`m = 0, 1`, each `c_m` a vector in
+//! the layout's position components; units of L): zero at both ends, as the paper's path
+//! terms are (§7.1); its frame stays the course's. Every shape along it is the equilibrium its
+//! end pose produces, marched from the start along `k` as the replay does, so the plan
+//! coincides with its replay by construction. The objective is a smoothed maximum
+//! (log-sum-exp) of those equilibria's energies `U_j`, plus a small tie-breaking term on how
+//! far the end's velocity leaves the course's, `w ∫ |Σ c_m b_m'(k)|² dk` (`w` a hundredth of
+//! the larger end energy per L²), which keeps the gripper on the shorter of routes of nearly
+//! equal peak.
 //!
 //! Its gradient needs no sensitivity of the shapes: by the envelope theorem the derivative of
 //! an equilibrium's energy with respect to the prescribed end position is minus the multipliers
 //! of the position rows (`ℒ = U + Σ λ c`, `c = x(L) − p`): the force the gripper exerts on the
 //! rod. Obstacle contacts stay in every solve; where they are active their multipliers take
 //! part in the equilibrium, and the envelope theorem holds as long as the contact set does not
-//! change. A solve that does not converge, or a shape that jumps (as a snap-through in the
-//! replay: farther than three times the straight path's shapes move, and 0.02 L), makes the
-//! objective infinite, and the line search backs off.
+//! change. A step whose solve does not converge, or whose shape jumps (as a snap-through in
+//! the replay: farther than three times the reference path's shapes move, and 0.02 L), is
+//! bisected as the replay's are; where that does not mend it the objective is infinite, and
+//! the line search backs off.
 //!
-//! BFGS minimises it in two stages, the second with the maximum ten times sharper. The
-//! optimised line is then judged as every pose line is (the replay with its bisections, the
-//! confirmation on twice the steps, stability, clearance on the verification grid), and it
-//! replaces the line only where it is executable and its peak energy is lower.
+//! BFGS minimises it in two stages, the second with the maximum ten times sharper, over at
+//! most [`MARCHES`] marches; a course that already peaks at an end shape (the lower bound on
+//! every path's peak) is left as it is. The optimised course — or, where its equilibria are no
+//! plan, the course half-way to it — is then judged as the course itself was (the replay with
+//! its bisections, the confirmation on twice the steps, stability, clearance on the
+//! verification grid), and it replaces the course only where it passes and peaks lower.
 
 use super::Planner;
+use super::end_course::EndCourse;
 use super::judge::Judged;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
-use super::pose_line::PoseLine;
+use super::replay::EarlyStop;
 use super::replay::{max_distance, solve_held};
+use super::settings::PoseOptimisation;
 use crate::optim::bfgs::{BfgsOptions, bfgs};
 use crate::rod::kinematics::Shape;
 use crate::statics::problem::StaticProblem;
@@ -66,7 +74,7 @@ pub struct March {
     pub gradients: Vec<[f64; 3]>,
 }
 
-/// The equilibria of `base` with the end at `line`'s poses from `k = 0` to 1 in `steps`
+/// The equilibria of `base` with the end at `course`'s poses from `k = 0` to 1 in `steps`
 /// uniform steps, each solved from the one before (the first from `start`), with the
 /// derivatives of their energies ([`March`]). A step whose solve does not converge or whose
 /// shape jumps farther than three times the reference shapes `reference(z)` move between the
@@ -75,7 +83,7 @@ pub struct March {
 pub fn march(
     base: &StaticProblem,
     start: &StaticSolution,
-    line: &PoseLine,
+    course: &EndCourse,
     reference: (&DeformationPath, &[f64]),
     (steps, refinements): (usize, usize),
     opts: &StaticOptions,
@@ -91,7 +99,7 @@ pub fn march(
     };
     let row = base.constraints.len();
     let solve = |k: f64, from: &StaticSolution| {
-        let pose = line.end_pose(model, k);
+        let pose = course.end_pose(model, k);
         let (p, sol) = solve_held(base, from, &pose, opts, true);
         let mut g = [0.0; 3];
         for (r, &(c, _)) in p.rows_of(row).zip(&pose.position) {
@@ -159,8 +167,8 @@ fn smooth_max(u: &[f64], beta: f64) -> (f64, Vec<f64>) {
 /// The objective of the optimisation (see the module documentation) and its gradient with
 /// respect to the terms, flattened as `x[m · comps.len() + i]` for component `comps[i]`.
 pub struct Objective<'a> {
-    /// The line without terms.
-    pub line: &'a PoseLine,
+    /// The course without terms.
+    pub course: &'a EndCourse,
     /// The position components optimised.
     pub comps: Vec<usize>,
     /// Sharpness of the smoothed maximum (per unit of dimensionless energy).
@@ -170,8 +178,8 @@ pub struct Objective<'a> {
 }
 
 impl Objective<'_> {
-    /// The line with terms `x`.
-    pub fn line_at(&self, x: &[f64]) -> PoseLine {
+    /// The course with terms `x`.
+    pub fn course_at(&self, x: &[f64]) -> EndCourse {
         let n = self.comps.len();
         let terms = (0..TERMS)
             .map(|m| {
@@ -182,11 +190,11 @@ impl Objective<'_> {
                 t
             })
             .collect();
-        self.line.with_terms(terms)
+        self.course.with_terms(terms)
     }
 
-    /// The objective at `x` given the march along [`Self::line_at`]`(x)`, with its gradient in
-    /// `g`.
+    /// The objective at `x` given the march along [`Self::course_at`]`(x)`, with its gradient
+    /// in `g`.
     pub fn value(&self, x: &[f64], march: &March, g: &mut [f64]) -> f64 {
         let n = self.comps.len();
         let (f, w) = smooth_max(&march.energies, self.beta);
@@ -214,37 +222,27 @@ impl Objective<'_> {
     }
 }
 
-/// What the optimisation found: the terms and the peak energies before and after (case units).
-#[derive(Clone, Debug)]
-pub struct Optimised {
-    /// The optimised line.
-    pub line: PoseLine,
-    /// Largest energy of the marched equilibria along the line as it was, and along the
-    /// optimised one (case units).
-    pub peaks: [f64; 2],
-    /// Marches run.
-    pub marches: usize,
-}
-
 impl Planner {
-    /// The terms on `line` that lower the peak energy of the equilibria along it (see the module
-    /// documentation); `None` where the march along the line itself fails, the run is stopped,
-    /// or nothing lowers the peak.
-    pub(super) fn optimise_pose_terms(&self, line: &PoseLine) -> Option<Optimised> {
+    /// The terms on `course` (without terms of its own) that lower the peak energy of the
+    /// equilibria along it (see the module documentation), the replay's jumps measured against
+    /// the shapes of `reference`; `None` where the march along the course itself fails, the
+    /// run is stopped, or nothing lowers the peak.
+    pub(super) fn optimise_course(
+        &self,
+        course: &EndCourse,
+        reference: (&DeformationPath, &[f64]),
+    ) -> Option<EndCourse> {
         let model = &self.base.model;
         let steps = (self.settings.replay_steps, self.settings.replay_refinements);
-        let path = self.path();
-        let z = vec![0.0; path.n_vars()];
         let opts = StaticOptions {
             stability: false,
             balance: false,
             ..self.static_options
         };
-        let plain = line.with_terms(Vec::new());
-        let run = |l: &PoseLine| march(&self.held, &self.start, l, (&path, &z), steps, &opts);
-        let first = run(&plain)?;
+        let run = |c: &EndCourse| march(&self.held, &self.start, c, reference, steps, &opts);
+        let first = run(course)?;
         let peak = |m: &March| m.energies.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        // Every line passes through both end shapes: the larger end energy bounds the peak.
+        // Every course passes through both end shapes: the larger end energy bounds the peak.
         let bound = first.energies[0].max(*first.energies.last()?);
         let at_bound = |u: f64| u <= bound + 1e-9 * bound.abs().max(1e-9);
         if at_bound(peak(&first)) {
@@ -255,16 +253,17 @@ impl Planner {
         let mut x = vec![0.0; TERMS * comps.len()];
         let mut marches = 1;
         let mut best: (f64, Vec<f64>) = (peak(&first), x.clone());
+        let mut objective = Objective {
+            course,
+            comps,
+            beta: 1.0,
+            weight: TRAVEL_WEIGHT * scale,
+        };
         for rel in SHARPNESS {
             if at_bound(best.0) {
                 break;
             }
-            let objective = Objective {
-                line: &plain,
-                comps: comps.clone(),
-                beta: rel / scale,
-                weight: TRAVEL_WEIGHT * scale,
-            };
+            objective.beta = rel / scale;
             let mut h = Vec::new();
             bfgs(
                 |x, g| {
@@ -273,7 +272,7 @@ impl Planner {
                         return f64::INFINITY;
                     }
                     marches += 1;
-                    match run(&objective.line_at(x)) {
+                    match run(&objective.course_at(x)) {
                         Some(m) => {
                             if peak(&m) < best.0 {
                                 best = (peak(&m), x.to_vec());
@@ -292,56 +291,74 @@ impl Planner {
                 },
             );
         }
-        let unit = model.rod.energy_unit();
-        let (low, x) = best;
-        (low < peak(&first)).then(|| Optimised {
-            line: Objective {
-                line: &plain,
-                comps,
-                beta: 1.0,
-                weight: 0.0,
-            }
-            .line_at(&x),
-            peaks: [peak(&first) * unit, low * unit],
-            marches,
+        (best.0 < peak(&first)).then(|| objective.course_at(&best.1))
+    }
+
+    /// The equilibria along `course` judged as a plan (as [`Self::judge_path`] judges a path's,
+    /// compared with the shapes of `reference`), on twice the contact samples where they still
+    /// dip ([`Self::with_finer_if_dipping`]).
+    pub(super) fn judge_course(
+        &self,
+        course: &Arc<EndCourse>,
+        reference: (&DeformationPath, &[f64]),
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let driven = Planner {
+            drive: Some(course.clone()),
+            ..self.clone()
+        };
+        let (path, z) = reference;
+        driven.with_finer_if_dipping(|pl| {
+            pl.judge_path(path, z, false, EarlyStop::Failure, fine, observer)
         })
     }
 
-    /// The plan along `line` (judged `found`, executable) or, where its optimised terms
-    /// ([`Self::optimise_pose_terms`]) give a line whose equilibria are also a plan, with a
-    /// lower peak energy, that one.
-    pub(super) fn optimised_pose_line(
+    /// The plan `found` (executable: the equilibria along `course`, whose replay is compared
+    /// with the shapes of `reference`) or, where the optimised terms on `course`
+    /// ([`Self::optimise_course`]) give a course whose equilibria are a plan too, with a lower
+    /// peak energy, that one, reported on the same trajectory.
+    pub(super) fn optimised_plan(
         &self,
-        line: &PoseLine,
+        course: EndCourse,
+        reference: (&DeformationPath, &[f64]),
         found: Judged,
         fine: &crate::rod::model::Model,
         observer: &mut dyn PlanObserver,
     ) -> Judged {
-        if !self.settings.pose_optimisation || self.stopped() || self.time_up() {
-            return found;
-        }
-        let Some(opt) = self.optimise_pose_terms(line) else {
+        let Some(e) = found.equilibrium_plan.as_ref().filter(|_| found.executable) else {
             return found;
         };
-        let before = found
-            .equilibrium_plan
-            .as_ref()
-            .map_or(f64::NAN, |e| e.u_max);
-        // The optimised line, and where its equilibria are no plan (most often: they press
-        // the rod into an obstacle between contact points), the line half-way to it.
-        let half: Vec<[f64; 3]> = opt
-            .line
+        let objective = self.base.objective;
+        let bound = self
+            .start
+            .energy
+            .value(objective)
+            .max(self.goal.energy.value(objective));
+        let wanted = match self.settings.pose_optimisation {
+            PoseOptimisation::Off => false,
+            PoseOptimisation::Fallback => e.trajectory != "optimal_path",
+            PoseOptimisation::All => true,
+        };
+        if !wanted || e.u_max <= bound + 1e-9 * bound.abs() || self.stopped() || self.time_up() {
+            return found;
+        }
+        let (before, trajectory) = (e.u_max, e.trajectory);
+        let Some(optimised) = self.optimise_course(&course, reference) else {
+            return found;
+        };
+        // The optimised course, and where its equilibria are no plan (most often: they press
+        // the rod into an obstacle between contact points), the course half-way to it.
+        let half: Vec<[f64; 3]> = optimised
             .terms()
             .iter()
             .map(|t| t.map(|v| 0.5 * v))
             .collect();
-        let mut optimised = Arc::new(opt.line);
-        let mut judged =
-            self.with_finer_if_dipping(|pl| pl.judge_pose_line(&optimised, fine, observer));
+        let mut optimised = Arc::new(optimised);
+        let mut judged = self.judge_course(&optimised, reference, fine, observer);
         if !judged.executable && !self.stopped() {
             optimised = Arc::new(optimised.with_terms(half));
-            judged =
-                self.with_finer_if_dipping(|pl| pl.judge_pose_line(&optimised, fine, observer));
+            judged = self.judge_course(&optimised, reference, fine, observer);
         }
         let after = judged
             .equilibrium_plan
@@ -352,6 +369,7 @@ impl Planner {
         }
         if let Some(e) = judged.equilibrium_plan.as_mut() {
             let l = self.base.model.rod.length;
+            e.set_trajectory(trajectory, optimised.detour());
             e.pose_terms = Some(optimised.terms().iter().map(|t| t.map(|v| v * l)).collect());
             e.pose_line_u_max = Some(before);
         }
@@ -423,8 +441,9 @@ mod tests {
         let n = comps.len();
         assert_eq!(n, 3);
         let x = [0.01, 0.005, 0.01, 0.005, -0.005, 0.005];
+        let course = crate::planner::end_course::EndCourse::line(line);
         let objective = Objective {
-            line: &line,
+            course: &course,
             comps,
             beta: 3.0,
             weight: 0.2,
@@ -433,7 +452,7 @@ mod tests {
             march(
                 &p.held,
                 &p.start,
-                &objective.line_at(x),
+                &objective.course_at(x),
                 (&path, &z),
                 steps,
                 &opts,

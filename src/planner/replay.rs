@@ -7,9 +7,9 @@
 //! step starts the solve nearer its answer. A jump that survives every bisection is a
 //! snap-through: the end pose alone cannot follow the path there.
 
+use super::end_course::EndCourse;
 use super::endpoints::EndPose;
 use super::observer::{PathKind, PlanObserver, ShapeRecord};
-use super::pose_line::PoseLine;
 use crate::planner::path::DeformationPath;
 use crate::planner::workers::{JOB_EQUILIBRIA, Workers};
 use crate::rod::kinematics::Shape;
@@ -289,7 +289,7 @@ pub fn replay_driven(
     start: &StaticSolution,
     path: &DeformationPath,
     z: &[f64],
-    drive: Option<&PoseLine>,
+    drive: Option<&EndCourse>,
     opts: ReplayOptions,
     static_opts: &StaticOptions,
     observer: &mut dyn PlanObserver,
@@ -309,7 +309,7 @@ pub fn replay_driven(
     };
     let solve = |k: f64, from: &State, target: &(Vec<f64>, Vec<[f64; 3]>, f64)| -> State {
         let pose = match drive {
-            Some(line) => line.end_pose(model, k),
+            Some(course) => course.end_pose(model, k),
             None => EndPose::of(model, &target.0, &target.1),
         };
         let (mut p, mut sol) = solve_held(base, &from.sol, &pose, static_opts, true);

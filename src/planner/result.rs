@@ -344,11 +344,12 @@ impl PlanResult {
     }
 
     /// Whether the replay is not the optimal path's: it followed the straight-line path's end
-    /// poses or a pose line.
+    /// poses, a pose line, or a course optimised in the end's pose space
+    /// ([`super::pose_optimisation`]; the optimal path's end poses with terms added).
     pub fn along_other_trajectory(&self) -> bool {
         self.equilibrium_plan
             .as_ref()
-            .is_some_and(|e| e.trajectory != "optimal_path")
+            .is_some_and(|e| e.trajectory != "optimal_path" || e.pose_terms.is_some())
     }
 
     /// The verdict: executable, or why not.

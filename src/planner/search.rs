@@ -2,6 +2,7 @@
 //! plan judged, the chosen plan's report, and the plan again towards a goal pose's equilibrium
 //! the gripper's motion reaches.
 
+use super::end_course::EndCourse;
 use super::equilibrium_plan::EquilibriumPlan;
 use super::judge::Judged;
 use super::observer::{PathKind, PlanObserver, RecordedShapes, ShapeRecord};
@@ -212,6 +213,21 @@ impl Planner {
                     }
                     None => {
                         let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
+                        // Executable by the equilibria along the optimal path's end poses: that
+                        // course optimised in the end's pose space, where that lowers the peak.
+                        let path = self.with_terms(runs[best].terms).path();
+                        let z = runs[best].plan.run.z.clone();
+                        let course = EndCourse::path(path.clone(), z.clone());
+                        let judged = if judged.executable
+                            && judged
+                                .equilibrium_plan
+                                .as_ref()
+                                .is_some_and(|e| e.executable && e.trajectory == "optimal_path")
+                        {
+                            self.optimised_plan(course, (&path, &z), judged, &fine, observer)
+                        } else {
+                            judged
+                        };
                         (runs, Some(best), judged)
                     }
                 },
@@ -275,10 +291,15 @@ impl Planner {
                     Some(l) => pl.judge_pose_line(l, &fine, observer),
                 });
                 if s.executable {
-                    found = Some(match &line {
-                        Some(l) => self.optimised_pose_line(l, s, &fine, observer),
-                        None => s,
-                    });
+                    // Its course optimised in the end's pose space, where that lowers the peak.
+                    let straight_path = self.path();
+                    let zero = vec![0.0; straight_path.n_vars()];
+                    let course = match &line {
+                        Some(l) => EndCourse::line((**l).clone()),
+                        None => EndCourse::path(straight_path.clone(), zero.clone()),
+                    };
+                    let reference = (&straight_path, &zero[..]);
+                    found = Some(self.optimised_plan(course, reference, s, &fine, observer));
                     break;
                 }
                 let what = match &line {
@@ -330,7 +351,7 @@ impl Planner {
         // Along a pose line, the end poses of the replayed equilibria, which hold them.
         let along_line = equilibrium_plan
             .as_ref()
-            .is_some_and(|e| e.trajectory == "pose_line");
+            .is_some_and(|e| e.trajectory == "pose_line" || e.pose_terms.is_some());
         let trajectory = if along_line {
             let shapes: Vec<(f64, Vec<f64>)> =
                 rep.steps.iter().map(|s| (s.k, s.a.clone())).collect();

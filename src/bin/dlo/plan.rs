@@ -663,20 +663,22 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 Some(_) => "a line in its pose space; the replay is that line's".into(),
                 None => "the straight-line path's end poses".into(),
             };
-            // An optimised line ([`dlo_planner::planner::pose_optimisation`]).
-            let follows = match e.pose_line_u_max {
-                Some(u) => follows.replacen(
-                    "; the replay",
-                    &format!(
-                        ", its positions optimised (along the line itself the equilibria peak at U_max {u:.6e}); the replay"
-                    ),
-                    1,
-                ),
-                None => follows,
-            };
             let _ = writeln!(
                 o,
                 "  the optimal path is not executable ({why}); the gripper follows {follows}"
+            );
+        }
+        // A course optimised in the end's pose space
+        // ([`dlo_planner::planner::pose_optimisation`]).
+        if let (Some(u), Some(t)) = (e.pose_line_u_max, &e.pose_terms) {
+            let _ = writeln!(
+                o,
+                "  the end's positions along it optimised (terms {}): its equilibria peak at U_max {:.6e} instead of {u:.6e}",
+                t.iter()
+                    .map(|c| format!("[{:.4}, {:.4}, {:.4}]", c[0], c[1], c[2]))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                e.u_max
             );
         }
         let _ = writeln!(
