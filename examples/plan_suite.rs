@@ -543,7 +543,7 @@ pub fn run(
             .equilibrium_plan
             .as_ref()
             .filter(|_| executed.is_some())
-            .and_then(|e| e.pose_line_u_max.map(|before| [before, e.u_max])),
+            .and_then(|e| e.course_u_max.map(|before| [before, e.u_max])),
         reached_goal: r.reached_goal.is_some(),
         reached_not_replanned: r.reached_goal.as_ref().is_some_and(|g| !g.replanned()),
         why_not: executed.is_none().then(|| {

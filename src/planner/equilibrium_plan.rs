@@ -73,7 +73,8 @@ pub struct EquilibriumPlan {
     /// Whose end poses the gripper follows: `"optimal_path"` (the optimal path's, as the
     /// replay), `"straight_path"` (the straight-line path's, tried when no optimised path is
     /// executable, neither as it stands nor by its equilibria) or `"pose_line"` (a line in the
-    /// end's pose space, [`super::pose_line`], tried when neither of those executes).
+    /// end's pose space, [`super::pose_line`], tried when neither of those executes); with
+    /// [`Self::pose_terms`], those end poses with terms added.
     pub trajectory: &'static str,
     /// Along a pose line: how far it lifts the end mid-way against gravity (units of L).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -83,15 +84,16 @@ pub struct EquilibriumPlan {
     /// [`super::pose_line::Detour`]). Absent on lines not moved aside.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub side_over_l: Option<f64>,
-    /// Along an optimised pose line ([`super::pose_optimisation`]): the terms added to the
-    /// end's position, the `m`-th times `k^(m+1) (1 − k)` (case units, case frame). Absent on
-    /// a line as it was.
+    /// Along a course optimised in the end's pose space ([`super::pose_optimisation`]: the
+    /// pose line or the path's end poses of [`Self::trajectory`], with terms added): the terms
+    /// added to the end's position, the `m`-th times `k^(m+1) (1 − k)` (case units, case
+    /// frame). Absent on a course as it was.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pose_terms: Option<Vec<[f64; 3]>>,
-    /// Along an optimised pose line: the largest energy of the equilibria along the line as it
+    /// Along an optimised course: the largest energy of the equilibria along the course as it
     /// was (case units), against this plan's `u_max`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub pose_line_u_max: Option<f64>,
+    pub course_u_max: Option<f64>,
     /// Along another trajectory than the optimal path's: why the optimal path was not
     /// executable, as it stands or by its equilibria (`None` otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -360,7 +362,7 @@ impl Planner {
             lift_over_l: None,
             side_over_l: None,
             pose_terms: None,
-            pose_line_u_max: None,
+            course_u_max: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: Vec::new(),

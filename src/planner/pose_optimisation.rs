@@ -11,8 +11,8 @@
 //! coincides with its replay by construction. The objective is a smoothed maximum
 //! (log-sum-exp) of those equilibria's energies `U_j`, plus a small tie-breaking term on how
 //! far the end's velocity leaves the course's, `w ∫ |Σ c_m b_m'(k)|² dk` (`w` a hundredth of
-//! the larger end energy per L²), which keeps the gripper on the shorter of routes of nearly
-//! equal peak.
+//! the course's own peak energy per L²), which keeps the gripper on the shorter of routes of
+//! nearly equal peak.
 //!
 //! Its gradient needs no sensitivity of the shapes: by the envelope theorem the derivative of
 //! an equilibrium's energy with respect to the prescribed end position is minus the multipliers
@@ -24,9 +24,9 @@
 //! bisected as the replay's are; where that does not mend it the objective is infinite, and
 //! the line search backs off.
 //!
-//! BFGS minimises it in two stages, the second with the maximum ten times sharper, over at
-//! most [`MARCHES`] marches; a course that already peaks at an end shape (the lower bound on
-//! every path's peak) is left as it is. The optimised course — or, where its equilibria are no
+//! BFGS minimises it in two stages (the maximum's sharpness 30, then 300, over the course's
+//! own peak), over at most [`MARCHES`] marches; a course that already peaks at an end shape
+//! (the lower bound on every path's peak) is left as it is. The optimised course — or, where its equilibria are no
 //! plan, the course half-way to it — is then judged as the course itself was (the replay with
 //! its bisections, the confirmation on twice the steps, stability, clearance on the
 //! verification grid), and it replaces the course only where it passes and peaks lower.
@@ -36,8 +36,7 @@ use super::end_course::EndCourse;
 use super::judge::Judged;
 use super::observer::PlanObserver;
 use super::path::DeformationPath;
-use super::replay::EarlyStop;
-use super::replay::{max_distance, solve_held};
+use super::replay::{EarlyStop, max_distance, solve_held};
 use super::settings::PoseOptimisation;
 use crate::optim::bfgs::{BfgsOptions, bfgs};
 use crate::rod::kinematics::Shape;
@@ -48,12 +47,12 @@ use std::sync::Arc;
 /// Position terms optimised (`k (1 − k)` and `k² (1 − k)`).
 pub const TERMS: usize = 2;
 
-/// Sharpness of the smoothed maximum in its two stages, relative to the larger end energy: the
-/// log-sum-exp over `n` samples exceeds the maximum by at most `ln n / β`.
+/// Sharpness of the smoothed maximum in its two stages, over the peak energy of the course as
+/// it is: the log-sum-exp over `n` samples exceeds the maximum by at most `ln n / β`.
 const SHARPNESS: [f64; 2] = [30.0, 300.0];
 
-/// The tie-breaking weight on the end's velocity off the line, relative to the larger end
-/// energy (per L²).
+/// The tie-breaking weight on the end's velocity off the course, times the peak energy of the
+/// course as it is (per L²).
 const TRAVEL_WEIGHT: f64 = 0.01;
 
 /// BFGS iterations per stage.
@@ -62,7 +61,7 @@ const ITERATIONS: usize = 8;
 /// Marches at most, over both stages.
 const MARCHES: usize = 40;
 
-/// The equilibria along a line and the derivatives of their energies.
+/// The equilibria along a course and the derivatives of their energies.
 #[derive(Clone, Debug)]
 pub struct March {
     /// Path parameters, from 0 to 1.
@@ -371,7 +370,7 @@ impl Planner {
             let l = self.base.model.rod.length;
             e.set_trajectory(trajectory, optimised.detour());
             e.pose_terms = Some(optimised.terms().iter().map(|t| t.map(|v| v * l)).collect());
-            e.pose_line_u_max = Some(before);
+            e.course_u_max = Some(before);
         }
         judged
     }

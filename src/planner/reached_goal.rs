@@ -18,6 +18,7 @@
 //! they reached accepted as their end, every other check as before; the first that passes is
 //! the plan (with `replan_failed`), else the first plan is reported, with what the second met.
 
+use super::end_course::EndCourse;
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::equilibrium_plan::Reached;
 use super::judge::Judged;
@@ -137,8 +138,13 @@ impl Planner {
                 )
             });
             let ks: Vec<f64> = j.replay.steps.iter().map(|s| s.k).collect();
+            let optimised = j
+                .equilibrium_plan
+                .as_ref()
+                .is_some_and(|e| e.pose_terms.is_some());
+            // Along a pose line or an optimised course, the replayed equilibria's end poses.
             result.trajectory = match route.trajectory {
-                "pose_line" => {
+                t if optimised || t == "pose_line" => {
                     let shapes: Vec<(f64, Vec<f64>)> =
                         j.replay.steps.iter().map(|s| (s.k, s.a.clone())).collect();
                     Trajectory::of_shapes(model, &self.start.a, &shapes)
@@ -187,13 +193,20 @@ impl Planner {
         observer: &mut dyn PlanObserver,
     ) -> Option<Judged> {
         let path = self.path_of(result);
+        let straight = self.path();
+        let zero = vec![0.0; straight.n_vars()];
         let mut j = match route.trajectory {
             "pose_line" => {
                 let line = Arc::new(self.pose_line(route.line?)?);
-                self.with_finer_if_dipping(|pl| pl.judge_pose_line(&line, fine, observer))
+                let j = self.with_finer_if_dipping(|pl| pl.judge_pose_line(&line, fine, observer));
+                let course = EndCourse::line((*line).clone());
+                self.optimised_plan(course, (&straight, &zero), j, fine, observer)
             }
             "straight_path" => {
-                self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer))
+                let j =
+                    self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer));
+                let course = EndCourse::path(straight.clone(), zero.clone());
+                self.optimised_plan(course, (&straight, &zero), j, fine, observer)
             }
             _ => {
                 let planned = result.status == PlanStatus::Planned;
@@ -342,7 +355,7 @@ mod tests {
             lift_over_l: None,
             side_over_l: None,
             pose_terms: None,
-            pose_line_u_max: None,
+            course_u_max: None,
             optimal_path_not_executable: None,
             dips: false,
             reached_goals: vec![Reached {

@@ -670,7 +670,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         }
         // A course optimised in the end's pose space
         // ([`dlo_planner::planner::pose_optimisation`]).
-        if let (Some(u), Some(t)) = (e.pose_line_u_max, &e.pose_terms) {
+        if let (Some(u), Some(t)) = (e.course_u_max, &e.pose_terms) {
             let _ = writeln!(
                 o,
                 "  the end's positions along it optimised (terms {}): its equilibria peak at U_max {:.6e} instead of {u:.6e}",
