@@ -26,7 +26,8 @@
 //!
 //! BFGS minimises it in two stages (the maximum's sharpness 30, then 300, over the course's
 //! own peak), over at most [`MARCHES`] marches; a course that already peaks at an end shape
-//! (the lower bound on every path's peak) is left as it is. The optimised course — or, where its equilibria are no
+//! (the lower bound on every path's peak) is left as it is, and so is one whose peak the
+//! optimisation lowers by less than 1 %. The optimised course — or, where its equilibria are no
 //! plan, the course half-way to it — is then judged as the course itself was (the replay with
 //! its bisections, the confirmation on twice the steps, stability, clearance on the
 //! verification grid), and it replaces the course only where it passes and peaks lower.
@@ -60,6 +61,10 @@ const ITERATIONS: usize = 8;
 
 /// Marches at most, over both stages.
 const MARCHES: usize = 40;
+
+/// The least fraction of the course's own peak the optimised course must lower it by to be
+/// judged: a route changed for less is not worth its judgement.
+const LEAST_GAIN: f64 = 0.01;
 
 /// The equilibria along a course and the derivatives of their energies.
 #[derive(Clone, Debug)]
@@ -225,7 +230,7 @@ impl Planner {
     /// The terms on `course` (without terms of its own) that lower the peak energy of the
     /// equilibria along it (see the module documentation), the replay's jumps measured against
     /// the shapes of `reference`; `None` where the march along the course itself fails, the
-    /// run is stopped, or nothing lowers the peak.
+    /// run is stopped, or nothing lowers the peak by [`LEAST_GAIN`] of it.
     pub(super) fn optimise_course(
         &self,
         course: &EndCourse,
@@ -290,7 +295,7 @@ impl Planner {
                 },
             );
         }
-        (best.0 < peak(&first)).then(|| objective.course_at(&best.1))
+        (best.0 < peak(&first) - LEAST_GAIN * scale).then(|| objective.course_at(&best.1))
     }
 
     /// The equilibria along `course` judged as a plan (as [`Self::judge_path`] judges a path's,
