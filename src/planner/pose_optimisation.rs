@@ -25,9 +25,9 @@
 //! the line search backs off.
 //!
 //! BFGS minimises it in two stages (the maximum's sharpness 30, then 300, over the course's
-//! own peak), over at most [`MARCHES`] marches; a course that already peaks at an end shape
-//! (the lower bound on every path's peak) is left as it is, and so is one whose peak the
-//! optimisation lowers by less than 1 %. The optimised course — or, where its equilibria are no
+//! own peak), over at most 40 marches; a course that already peaks at an end shape (the lower
+//! bound on every path's peak) is left as it is, and so is one whose peak the optimisation
+//! lowers by less than 1 %. The optimised course — or, where its equilibria are no
 //! plan, the course half-way to it — is then judged as the course itself was (the replay with
 //! its bisections, the confirmation on twice the steps, stability, clearance on the
 //! verification grid), and it replaces the course only where it passes and peaks lower.
