@@ -202,8 +202,9 @@ pub struct Planner {
     /// again where the gripper's motion reaches that equilibrium and no plan to it executes
     /// ([`PlanSettings::reached_goal`]).
     ends_on: Option<Arc<Vec<[f64; 3]>>>,
-    /// The pose line the replays hold the end on instead of the end poses of the path they
-    /// replay: set on the copy that judges the equilibria along it ([`pose_line`]).
+    /// The course the replays hold the end on instead of the end poses of the path they
+    /// replay (a pose line, or a path's end poses with optimised terms): set on the copy that
+    /// judges the equilibria along it ([`pose_line`], [`pose_optimisation`]).
     drive: Option<Arc<end_course::EndCourse>>,
     /// Threads a start's path optimisation splits its samples over
     /// ([`PlanSettings::threads`]).

@@ -215,16 +215,15 @@ impl Planner {
                         let (runs, best, judged) = self.optimise_and_judge(&fine, observer);
                         // Executable by the equilibria along the optimal path's end poses: that
                         // course optimised in the end's pose space, where that lowers the peak.
-                        let path = self.with_terms(runs[best].terms).path();
-                        let z = runs[best].plan.run.z.clone();
-                        let course = EndCourse::path(path.clone(), z.clone());
-                        let judged = if judged.executable
-                            && judged
-                                .equilibrium_plan
-                                .as_ref()
-                                .is_some_and(|e| e.executable && e.trajectory == "optimal_path")
-                        {
-                            self.optimised_plan(course, (&path, &z), judged, &fine, observer)
+                        let by_equilibria = judged
+                            .equilibrium_plan
+                            .as_ref()
+                            .is_some_and(|e| e.executable && e.trajectory == "optimal_path");
+                        let judged = if judged.executable && by_equilibria {
+                            let path = self.with_terms(runs[best].terms).path();
+                            let z = &runs[best].plan.run.z;
+                            let course = EndCourse::path(path.clone(), z.clone());
+                            self.optimised_plan(course, (&path, z), judged, &fine, observer)
                         } else {
                             judged
                         };
@@ -348,7 +347,8 @@ impl Planner {
         } else {
             (&path, &chosen.z)
         };
-        // Along a pose line, the end poses of the replayed equilibria, which hold them.
+        // Along a pose line or an optimised course, the end poses of the replayed equilibria,
+        // which hold them.
         let along_line = equilibrium_plan
             .as_ref()
             .is_some_and(|e| e.trajectory == "pose_line" || e.pose_terms.is_some());
