@@ -609,6 +609,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
     let by_straight = out.iter().filter(|o| o.by_straight).count();
     let by_line = out.iter().filter(|o| o.by_pose_line.is_some()).count();
     let reached = out.iter().filter(|o| o.reached_goal).count();
+    let optimised = out.iter().filter(|o| o.pose_optimised.is_some()).count();
     let snaps = out.iter().filter(|o| o.snaps).count();
     let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
     let mut travel: Vec<f64> = out.iter().map(|o| o.travel).collect();
@@ -618,7 +619,7 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         .fold(f64::INFINITY, f64::min);
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     format!(
-        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path, {by_line} along a pose line; {reached} to a reached goal) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
+        "| {kind} | {n} | {planned} ({:.0} %) | {coincide} ({:.0} %) | {executable} ({:.0} %; {by_equilibria} by the equilibria, {by_straight} of them along the straight path, {by_line} along a pose line; {reached} to a reached goal; {optimised} optimised in the end's pose space) | {snaps} | {:.3} s | {:.3} s | {:+.2e} L | {:.2} / {:.2} |\n",
         pct(planned),
         pct(coincide),
         pct(executable),
