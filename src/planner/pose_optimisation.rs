@@ -333,12 +333,16 @@ impl Planner {
         let Some(e) = found.equilibrium_plan.as_ref().filter(|_| found.executable) else {
             return found;
         };
-        let objective = self.base.objective;
-        let bound = self
-            .start
-            .energy
-            .value(objective)
-            .max(self.goal.energy.value(objective));
+        // The larger energy of the replayed equilibria at the ends (the goal's, or another
+        // equilibrium of the goal pose the course reached): no course peaks lower.
+        let steps = &found.replay.steps;
+        let Some(bound) = steps
+            .first()
+            .zip(steps.last())
+            .map(|(a, b)| a.u_feasible.max(b.u_feasible))
+        else {
+            return found;
+        };
         let wanted = match self.settings.pose_optimisation {
             PoseOptimisation::Off => false,
             PoseOptimisation::Fallback => e.trajectory != "optimal_path",
