@@ -19,7 +19,6 @@ use super::end_course::EndCourse;
 use super::endpoints::EndPose;
 use super::judge::Judged;
 use super::observer::PlanObserver;
-use super::replay::EarlyStop;
 use crate::rod::model::Model;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::sync::Arc;
@@ -234,13 +233,10 @@ impl Planner {
         fine: &Model,
         observer: &mut dyn PlanObserver,
     ) -> Judged {
-        let driven = Planner {
-            drive: Some(Arc::new(EndCourse::line((**line).clone()))),
-            ..self.clone()
-        };
+        let course = Arc::new(EndCourse::line((**line).clone()));
         let path = self.path();
         let z = vec![0.0; path.n_vars()];
-        let mut judged = driven.judge_path(&path, &z, false, EarlyStop::Failure, fine, observer);
+        let mut judged = self.judge_driven(&course, (&path, &z), fine, observer);
         if let Some(e) = judged.equilibrium_plan.as_mut() {
             e.set_trajectory("pose_line", Some(line.detour));
         }

@@ -298,10 +298,10 @@ impl Planner {
         (best.0 < peak(&first) - LEAST_GAIN * scale).then(|| objective.course_at(&best.1))
     }
 
-    /// The equilibria along `course` judged as a plan (as [`Self::judge_path`] judges a path's,
-    /// compared with the shapes of `reference`), on twice the contact samples where they still
-    /// dip ([`Self::with_finer_if_dipping`]).
-    pub(super) fn judge_course(
+    /// The equilibria along `course` judged as a plan on the verification model `fine` (as
+    /// [`Self::judge_path`] judges a path's, compared with the shapes of `reference`), their
+    /// replays ending at the first failure.
+    pub(super) fn judge_driven(
         &self,
         course: &Arc<EndCourse>,
         reference: (&DeformationPath, &[f64]),
@@ -313,9 +313,19 @@ impl Planner {
             ..self.clone()
         };
         let (path, z) = reference;
-        driven.with_finer_if_dipping(|pl| {
-            pl.judge_path(path, z, false, EarlyStop::Failure, fine, observer)
-        })
+        driven.judge_path(path, z, false, EarlyStop::Failure, fine, observer)
+    }
+
+    /// [`Self::judge_driven`], on twice the contact samples where the equilibria still dip
+    /// ([`Self::with_finer_if_dipping`]).
+    pub(super) fn judge_course(
+        &self,
+        course: &Arc<EndCourse>,
+        reference: (&DeformationPath, &[f64]),
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        self.with_finer_if_dipping(|pl| pl.judge_driven(course, reference, fine, observer))
     }
 
     /// The plan `found` (executable: the equilibria along `course`, whose replay is compared
