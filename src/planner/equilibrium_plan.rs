@@ -98,6 +98,15 @@ pub struct EquilibriumPlan {
     /// executable, as it stands or by its equilibria (`None` otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal_path_not_executable: Option<String>,
+    /// The retries of these equilibria that were no plan either, in the order they ran: what
+    /// each changed (another trajectory, the contacts on chords, held off the obstacles, …)
+    /// and why it failed. [`Self::reason`] holds the same, after the first failure, as one
+    /// sentence. Absent where nothing was retried.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub retries: Vec<FailedRetry>,
+    /// [`Self::reason`] as it was before the first retry failed ([`Self::own_reason`]).
+    #[serde(skip)]
+    pub(crate) own: Option<String>,
     /// The shapes dip into an obstacle between the solves' contact points.
     #[serde(skip)]
     pub(crate) dips: bool,
@@ -108,6 +117,16 @@ pub struct EquilibriumPlan {
     /// in the order they ran.
     #[serde(skip)]
     pub(crate) reached_goals: Vec<Reached>,
+}
+
+/// A retry of replayed equilibria that was no plan either ([`EquilibriumPlan::retries`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FailedRetry {
+    /// What the retry changed: `"replayed with contacts on chords"`, `"along the end's pose
+    /// line lifted 0.3 L"`, … (a retry of a retry names both, the first one first).
+    pub attempt: String,
+    /// Why its equilibria are no plan.
+    pub reason: String,
 }
 
 /// Another equilibrium of the goal pose that replayed equilibria reached
@@ -125,16 +144,51 @@ pub(crate) struct Reached {
 impl EquilibriumPlan {
     /// Adds to [`Self::reason`] why a second attempt (`attempt`: what it changed) failed too.
     pub(super) fn retry_failed(&mut self, attempt: &str, why: &str) {
+        self.add_retry(
+            attempt,
+            why,
+            vec![FailedRetry {
+                attempt: attempt.into(),
+                reason: why.into(),
+            }],
+        );
+    }
+
+    /// Adds `why` to [`Self::reason`] and `listed` to [`Self::retries`].
+    fn add_retry(&mut self, attempt: &str, why: &str, listed: Vec<FailedRetry>) {
+        if self.retries.is_empty() {
+            self.own.clone_from(&self.reason);
+        }
         let first = self.reason.take().unwrap_or_default();
         self.reason = Some(format!("{first}; {attempt}: {why}"));
+        self.retries.extend(listed);
+    }
+
+    /// Why these equilibria themselves are no plan: [`Self::reason`] without the failures of
+    /// their retries ([`Self::retries`]), which follow it there.
+    pub fn own_reason(&self) -> Option<&str> {
+        if self.retries.is_empty() {
+            self.reason.as_deref()
+        } else {
+            self.own.as_deref()
+        }
     }
 
     /// [`Self::retry_failed`] with the reason of `retry`, the equilibria of a second attempt
     /// (`attempt`: what it changed), which are no plan either; the other equilibria of the
-    /// goal pose `retry` reached follow these' ([`Self::reached_goals`]).
+    /// goal pose `retry` reached follow these' ([`Self::reached_goals`]). Its failure is listed
+    /// in [`Self::retries`] as its own, then its retries' one by one.
     pub(super) fn retry_failed_as(&mut self, attempt: &str, retry: &EquilibriumPlan) {
         if let Some(why) = &retry.reason {
-            self.retry_failed(attempt, why);
+            let own = FailedRetry {
+                attempt: attempt.into(),
+                reason: retry.own_reason().unwrap_or(why).into(),
+            };
+            let theirs = retry.retries.iter().map(|r| FailedRetry {
+                attempt: format!("{attempt}, {}", r.attempt),
+                reason: r.reason.clone(),
+            });
+            self.add_retry(attempt, why, std::iter::once(own).chain(theirs).collect());
         }
         self.reached_goals
             .extend(retry.reached_goals.iter().cloned());
@@ -364,6 +418,8 @@ impl Planner {
             pose_terms: None,
             course_u_max: None,
             optimal_path_not_executable: None,
+            retries: Vec::new(),
+            own: None,
             dips: false,
             reached_goals: Vec::new(),
         };
@@ -450,7 +506,89 @@ impl Planner {
 }
 
 #[cfg(test)]
+impl EquilibriumPlan {
+    /// Equilibria along the optimal path's trajectory that are no plan, for `reason`.
+    pub(crate) fn failed(reason: &str) -> EquilibriumPlan {
+        EquilibriumPlan {
+            executable: false,
+            reason: Some(reason.into()),
+            u_max: 1.0,
+            k_at_u_max: 1.0,
+            min_clearance: None,
+            max_contact_force: 0.0,
+            k_at_max_contact_force: 0.0,
+            confirmation_steps: None,
+            confirmation_deviation_over_l: None,
+            contact: "points",
+            contact_margin: None,
+            contact_samples: None,
+            trajectory: "optimal_path",
+            lift_over_l: None,
+            side_over_l: None,
+            pose_terms: None,
+            course_u_max: None,
+            optimal_path_not_executable: None,
+            retries: Vec::new(),
+            own: None,
+            dips: false,
+            reached_goals: Vec::new(),
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
+    use super::{EquilibriumPlan, FailedRetry};
+
+    /// Each failed retry is listed with what it changed and why it failed, a retry's own
+    /// retries after it with both names; the reason holds the same as one sentence, after the
+    /// plan's own failure, which stays apart.
+    #[test]
+    fn failed_retries_are_listed_one_by_one() {
+        let mut plan = EquilibriumPlan::failed("the replay ends elsewhere");
+        assert_eq!(plan.own_reason(), Some("the replay ends elsewhere"));
+        plan.retry_failed(
+            "replayed with contacts on chords",
+            "the replay snaps through",
+        );
+        let mut line = EquilibriumPlan::failed("solves did not converge");
+        line.retry_failed("replayed on chords", "a shape dips");
+        plan.retry_failed_as("along the end's pose line", &line);
+        let listed = |attempt: &str, reason: &str| FailedRetry {
+            attempt: attempt.into(),
+            reason: reason.into(),
+        };
+        assert_eq!(
+            plan.retries,
+            [
+                listed(
+                    "replayed with contacts on chords",
+                    "the replay snaps through"
+                ),
+                listed("along the end's pose line", "solves did not converge"),
+                listed(
+                    "along the end's pose line, replayed on chords",
+                    "a shape dips"
+                ),
+            ]
+        );
+        assert_eq!(plan.own_reason(), Some("the replay ends elsewhere"));
+        assert_eq!(
+            plan.reason.as_deref(),
+            Some(
+                "the replay ends elsewhere; replayed with contacts on chords: the replay snaps through; \
+                 along the end's pose line: solves did not converge; replayed on chords: a shape dips"
+            )
+        );
+        // Not serialised where nothing was retried.
+        let json = serde_json::to_value(EquilibriumPlan::failed("x")).unwrap();
+        assert!(json.get("retries").is_none());
+        assert_eq!(
+            serde_json::to_value(&plan).unwrap()["retries"][2]["reason"],
+            "a shape dips"
+        );
+    }
+
     /// Nine decimals at most, no trailing zeros, and no rounding residue of a sum of steps.
     #[test]
     fn k_lists_read_as_short_decimals() {

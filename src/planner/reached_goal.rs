@@ -339,30 +339,12 @@ mod tests {
     /// Equilibria that ended on `a` (one coefficient) along the optimal path's trajectory.
     fn ended_on(a: f64) -> EquilibriumPlan {
         EquilibriumPlan {
-            executable: false,
-            reason: Some("the replay ends elsewhere".into()),
-            u_max: 1.0,
-            k_at_u_max: 1.0,
-            min_clearance: None,
-            max_contact_force: 0.0,
-            k_at_max_contact_force: 0.0,
-            confirmation_steps: None,
-            confirmation_deviation_over_l: None,
-            contact: "points",
-            contact_margin: None,
-            contact_samples: None,
-            trajectory: "optimal_path",
-            lift_over_l: None,
-            side_over_l: None,
-            pose_terms: None,
-            course_u_max: None,
-            optimal_path_not_executable: None,
-            dips: false,
             reached_goals: vec![Reached {
                 a: vec![a],
                 trajectory: "optimal_path",
                 line: None,
             }],
+            ..EquilibriumPlan::failed("the replay ends elsewhere")
         }
     }
 

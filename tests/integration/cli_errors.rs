@@ -525,6 +525,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     let logs_s = logs.to_str().unwrap();
     let json = |out: &str| -> serde_json::Value { serde_json::from_str(out).unwrap() };
     let plan_json = |case: &str| run(&["plan", case, "--json", "--log-dir", logs_s]);
+    let plan_text = |case: &str| run(&["plan", case, "--log-dir", logs_s]);
     let log_ok = |name: &str| {
         let bytes = std::fs::read(logs.join(format!("{name}.mcap"))).unwrap();
         assert!(bytes.starts_with(b"\x89MCAP0\r\n") && bytes.ends_with(b"\x89MCAP0\r\n"));
@@ -707,9 +708,44 @@ fn plan_prints_documented_json_and_exit_codes() {
     let why = v["equilibrium_plan"]["reason"].as_str().expect("a reason");
     assert_eq!(v["equilibrium_plan"]["executable"], false);
     assert!(why.contains("snaps through"), "{why}");
+    // The message gives their own failure (the first of the report's reason) and counts the
+    // retries that failed too; the report lists each, and its reason holds every one.
+    let own = why.split("; ").next().unwrap();
     assert!(
-        err.contains("the replayed equilibria are not a plan either") && err.contains(why),
+        err.contains(&format!(
+            "the replayed equilibria are not a plan either: {own}; "
+        )),
         "{err}"
+    );
+    let retries = v["equilibrium_plan"]["retries"]
+        .as_array()
+        .expect("retries");
+    assert!(!retries.is_empty());
+    assert!(
+        err.contains(&format!("; {} retries failed too (", retries.len())),
+        "{err}"
+    );
+    for r in retries {
+        let (attempt, reason) = (
+            r["attempt"].as_str().unwrap(),
+            r["reason"].as_str().unwrap(),
+        );
+        assert!(
+            why.contains(&format!("{attempt}: {reason}")),
+            "{r} not in {why}"
+        );
+    }
+    // The summary lists them one a line.
+    let (_, summary, _) = plan_text(snap.to_str().unwrap());
+    let r0 = &retries[0];
+    assert!(
+        summary.contains("  retried, no plan either:\n")
+            && summary.contains(&format!(
+                "\n    {}: {}\n",
+                r0["attempt"].as_str().unwrap(),
+                r0["reason"].as_str().unwrap()
+            )),
+        "{summary}"
     );
     log_ok("snap");
 }

@@ -423,15 +423,60 @@ fn contact_tries_text(
 
 /// Why the replayed equilibria are not a plan either, when they were checked, and that the
 /// time limit ended the search, when it did.
+/// Their own failure, then how many retries failed too and how (each retry is listed in the
+/// summary and in the report).
 fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
     let why = result
         .equilibrium_plan
         .as_ref()
-        .and_then(|e| e.reason.as_ref())
-        .map_or(String::new(), |why| {
-            format!("; the replayed equilibria are not a plan either: {why}")
+        .and_then(|e| Some((e.own_reason()?, &e.retries)))
+        .map_or(String::new(), |(own, retries)| {
+            let also = if retries.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; {} retr{} failed too ({}; each in the summary and in the report's equilibrium_plan.retries)",
+                    retries.len(),
+                    if retries.len() == 1 { "y" } else { "ies" },
+                    retry_outcomes(retries)
+                )
+            };
+            format!("; the replayed equilibria are not a plan either: {own}{also}")
         });
     format!("{why}{}", time_limit_note(result))
+}
+
+/// How the retries `retries` failed, counted by kind: `5 snap through, 2 stop converging`.
+fn retry_outcomes(retries: &[dlo_planner::planner::equilibrium_plan::FailedRetry]) -> String {
+    // (The first that a reason mentions.)
+    let kinds = [
+        ("the confirmation replay", "fail their confirmation replay"),
+        ("the replay snaps through", "snap through"),
+        ("replay solves did not converge", "stop converging"),
+        (
+            "the replay ends",
+            "end on another equilibrium of the goal pose",
+        ),
+        ("a replayed shape comes", "dip into an obstacle"),
+        ("a replayed shape crosses itself", "cross themselves"),
+    ];
+    let mut counts = vec![0usize; kinds.len() + 1];
+    for r in retries {
+        let i = kinds
+            .iter()
+            .position(|(p, _)| r.reason.contains(p))
+            .unwrap_or(kinds.len());
+        counts[i] += 1;
+    }
+    kinds
+        .iter()
+        .map(|(_, name)| *name)
+        .chain(std::iter::once("fail otherwise"))
+        .zip(counts)
+        .filter(|(_, n)| *n > 0)
+        .map(|(name, n)| format!("{n} {name}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// That the time limit ended the search, when it did (appended to a failure's message).
@@ -684,7 +729,7 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
         let _ = writeln!(
             o,
             "  replayed equilibria as the plan: {}; U_max {:.6e} at k = {:.3}{}{}",
-            match &e.reason {
+            match e.own_reason() {
                 None => "executable".to_string(),
                 Some(why) => format!("not executable ({why})"),
             },
@@ -707,6 +752,13 @@ pub(crate) fn plan_summary(r: &PlanReport) -> String {
                 _ => String::new(),
             }
         );
+        // Retries that were no plan either, one a line.
+        if !e.retries.is_empty() {
+            let _ = writeln!(o, "  retried, no plan either:");
+        }
+        for r in &e.retries {
+            let _ = writeln!(o, "    {}: {}", r.attempt, r.reason);
+        }
     }
     let t = &p.trajectory;
     if t.poses.is_empty() {
