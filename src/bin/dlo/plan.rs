@@ -421,10 +421,9 @@ fn contact_tries_text(
         .join(", ")
 }
 
-/// Why the replayed equilibria are not a plan either, when they were checked, and that the
-/// time limit ended the search, when it did.
-/// Their own failure, then how many retries failed too and how (each retry is listed in the
-/// summary and in the report).
+/// Why the replayed equilibria are not a plan either, when they were checked (their own
+/// failure, then how many retries failed too and how; the summary and the report list each
+/// retry), and that the time limit ended the search, when it did.
 fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
     let why = result
         .equilibrium_plan
