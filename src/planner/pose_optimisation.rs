@@ -328,6 +328,31 @@ impl Planner {
         self.with_finer_if_dipping(|pl| pl.judge_driven(course, reference, fine, observer))
     }
 
+    /// The equilibria along the straight-line path's end poses (`line` `None`) or along a pose
+    /// line, judged (on twice the contact samples where they still dip) and, where they are a
+    /// plan, their course optimised in the end's pose space ([`Self::optimised_plan`]).
+    pub(super) fn judge_other_course(
+        &self,
+        line: Option<&Arc<super::pose_line::PoseLine>>,
+        fine: &crate::rod::model::Model,
+        observer: &mut dyn PlanObserver,
+    ) -> Judged {
+        let found = self.with_finer_if_dipping(|pl| match line {
+            None => pl.judge_straight_trajectory(fine, observer),
+            Some(l) => pl.judge_pose_line(l, fine, observer),
+        });
+        if !found.executable {
+            return found;
+        }
+        let straight = self.path();
+        let zero = vec![0.0; straight.n_vars()];
+        let course = match line {
+            Some(l) => EndCourse::line((**l).clone()),
+            None => EndCourse::path(straight.clone(), zero.clone()),
+        };
+        self.optimised_plan(course, (&straight, &zero), found, fine, observer)
+    }
+
     /// The plan `found` (executable: the equilibria along `course`, whose replay is compared
     /// with the shapes of `reference`) or, where the optimised terms on `course`
     /// ([`Self::optimise_course`]) give a course whose equilibria are a plan too, with a lower

@@ -18,7 +18,6 @@
 //! they reached accepted as their end, every other check as before; the first that passes is
 //! the plan (with `replan_failed`), else the first plan is reported, with what the second met.
 
-use super::end_course::EndCourse;
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
 use super::equilibrium_plan::Reached;
 use super::judge::Judged;
@@ -193,21 +192,12 @@ impl Planner {
         observer: &mut dyn PlanObserver,
     ) -> Option<Judged> {
         let path = self.path_of(result);
-        let straight = self.path();
-        let zero = vec![0.0; straight.n_vars()];
         let mut j = match route.trajectory {
             "pose_line" => {
                 let line = Arc::new(self.pose_line(route.line?)?);
-                let j = self.with_finer_if_dipping(|pl| pl.judge_pose_line(&line, fine, observer));
-                let course = EndCourse::line((*line).clone());
-                self.optimised_plan(course, (&straight, &zero), j, fine, observer)
+                self.judge_other_course(Some(&line), fine, observer)
             }
-            "straight_path" => {
-                let j =
-                    self.with_finer_if_dipping(|pl| pl.judge_straight_trajectory(fine, observer));
-                let course = EndCourse::path(straight.clone(), zero.clone());
-                self.optimised_plan(course, (&straight, &zero), j, fine, observer)
-            }
+            "straight_path" => self.judge_other_course(None, fine, observer),
             _ => {
                 let planned = result.status == PlanStatus::Planned;
                 return Some(self.with_finer_if_dipping(|pl| {

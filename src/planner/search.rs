@@ -285,20 +285,10 @@ impl Planner {
                 {
                     break;
                 }
-                let s = self.with_finer_if_dipping(|pl| match &line {
-                    None => pl.judge_straight_trajectory(&fine, observer),
-                    Some(l) => pl.judge_pose_line(l, &fine, observer),
-                });
+                // (Its course optimised in the end's pose space where it is a plan.)
+                let s = self.judge_other_course(line.as_ref(), &fine, observer);
                 if s.executable {
-                    // Its course optimised in the end's pose space, where that lowers the peak.
-                    let straight_path = self.path();
-                    let zero = vec![0.0; straight_path.n_vars()];
-                    let course = match &line {
-                        Some(l) => EndCourse::line((**l).clone()),
-                        None => EndCourse::path(straight_path.clone(), zero.clone()),
-                    };
-                    let reference = (&straight_path, &zero[..]);
-                    found = Some(self.optimised_plan(course, reference, s, &fine, observer));
+                    found = Some(s);
                     break;
                 }
                 let what = match &line {
