@@ -323,8 +323,8 @@ fn bad_cases() -> Vec<(&'static str, String, &'static str)> {
 
 #[test]
 fn malformed_cases_give_exit_code_2_and_name_the_problem() {
-    let dir = std::env::temp_dir().join(format!("dlo_bad_cases_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo_bad_cases");
+    let dir = scratch.path();
     std::fs::write(dir.join("empty.obj"), "# nothing here\n").unwrap();
     let cases = bad_cases();
     assert!(cases.len() >= 20);
@@ -346,7 +346,6 @@ fn malformed_cases_give_exit_code_2_and_name_the_problem() {
             assert!(stdout.is_empty(), "{label}: half-written output: {stdout}");
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -420,8 +419,8 @@ fn shipped_pinned_case_prints_documented_json() {
 /// named, and no log is written for a case that fails validation.
 #[test]
 fn plan_margin_and_log_commands_reject_bad_input() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli");
+    let dir = scratch.path();
     let no_plan = dir.join("no_plan.json");
     std::fs::write(&no_plan, format!("{{{GOOD_ROD}}}")).unwrap();
     let logs = dir.join("logs");
@@ -510,7 +509,6 @@ fn plan_margin_and_log_commands_reject_bad_input() {
         );
     }
     assert!(!dir.join("fixed.mcap").exists(), "no half-written output");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `dlo plan --json` prints the documented keys, and its exit code tells the three outcomes
@@ -519,8 +517,8 @@ fn plan_margin_and_log_commands_reject_bad_input() {
 /// and a readable log are written in every case; the errors name the file.
 #[test]
 fn plan_prints_documented_json_and_exit_codes() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-plan-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-plan");
+    let dir = scratch.path();
     let logs = dir.join("logs");
     let logs_s = logs.to_str().unwrap();
     let json = |out: &str| -> serde_json::Value { serde_json::from_str(out).unwrap() };
@@ -754,8 +752,8 @@ fn plan_prints_documented_json_and_exit_codes() {
 /// and says so; exit 1: a log that cannot be created names the file and the system's reason.
 #[test]
 fn unconverged_solve_and_unwritable_log_exit_codes() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-codes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-codes");
+    let dir = scratch.path();
     let shipped = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/planning_cases/pinned_buckling_080.json"
@@ -807,8 +805,8 @@ fn unconverged_solve_and_unwritable_log_exit_codes() {
 /// needs.
 #[test]
 fn many_cases_run_in_parallel_with_the_worst_exit_code() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-batch-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-batch");
+    let dir = scratch.path();
     let bad = dir.join("bad.json");
     std::fs::write(&bad, r#"{"rod": {"length": -1, "flexural_rigidity": 1}}"#).unwrap();
     let logs = dir.join("logs");
@@ -868,8 +866,8 @@ fn many_cases_run_in_parallel_with_the_worst_exit_code() {
 /// stdout on a full device is exit 1, a closed pipe ends the output quietly.
 #[test]
 fn hostile_inputs_and_outputs_fail_cleanly() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-hostile-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-hostile");
+    let dir = scratch.path();
     let logs = dir.join("logs");
     let logs_s = logs.to_str().unwrap();
     let grasp = std::fs::read_to_string(concat!(
@@ -984,8 +982,8 @@ fn hostile_inputs_and_outputs_fail_cleanly() {
 /// shape reaches this pose"); a mesh written with per-face vertex copies is accepted.
 #[test]
 fn meshes_that_bound_no_solid_are_rejected() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-meshes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-meshes");
+    let dir = scratch.path();
     let root = env!("CARGO_MANIFEST_DIR");
     let cube = std::fs::read_to_string(format!("{root}/planning_cases/meshes/cube.obj")).unwrap();
     let verts: Vec<&str> = cube.lines().filter(|l| l.starts_with("v ")).collect();
@@ -1083,7 +1081,6 @@ fn meshes_that_bound_no_solid_are_rejected() {
         dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "per-face vertex copies: {err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Sizes and magnitudes that would make a run take unbounded time or overflow its arithmetic are
@@ -1093,8 +1090,8 @@ fn meshes_that_bound_no_solid_are_rejected() {
 /// obstacle names the obstacle.
 #[test]
 fn limits_warnings_and_blocked_poses_are_reported_before_work() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-limits-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-limits");
+    let dir = scratch.path();
     let root = env!("CARGO_MANIFEST_DIR");
     let read = |n: &str| -> serde_json::Value {
         serde_json::from_str(
@@ -1262,15 +1259,14 @@ fn limits_warnings_and_blocked_poses_are_reported_before_work() {
     let report: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(report["verdict"], "unreachable", "{out}");
     assert_eq!(report["end"], "goal", "{out}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Extreme numbers in an error are written in exponent notation: the message stays short
 /// (Rust writes 1e300 plainly with 301 digits).
 #[test]
 fn extreme_numbers_in_errors_are_written_short() {
-    let dir = std::env::temp_dir().join(format!("dlo-cli-extreme-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-cli-extreme");
+    let dir = scratch.path();
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/planning_cases/plan_paper_planar.json"

@@ -12,8 +12,8 @@ fn plan_variant(tag: &str, edit: impl FnOnce(&mut serde_json::Value)) -> (Option
         edit(v);
         text = v.to_string();
     });
-    let dir = std::env::temp_dir().join(format!("dlo-advice-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new(&format!("dlo-advice-{tag}"));
+    let dir = scratch.path();
     let file = dir.join("case.json");
     std::fs::write(&file, &text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_dlo"))
@@ -22,7 +22,6 @@ fn plan_variant(tag: &str, edit: impl FnOnce(&mut serde_json::Value)) -> (Option
         .arg(&file)
         .output()
         .unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
     (
         out.status.code(),
         String::from_utf8_lossy(&out.stderr).into_owned(),

@@ -1012,8 +1012,8 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
     assert!(r.optimiser.is_none() && r.starts.is_empty() && !r.straight_path_plan);
     assert!(r.replay.steps.is_empty() && r.equilibrium_plan.is_none());
 
-    let dir = std::env::temp_dir().join(format!("dlo-end-inside-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = crate::common::Scratch::new("dlo-end-inside");
+    let dir = scratch.path();
     let file = dir.join("planar_30.json");
     std::fs::write(&file, &text).unwrap();
     // `dlo plan` on the case, with a JSON report or the text summary.
@@ -1056,7 +1056,6 @@ fn an_end_inside_an_obstacle_is_reported_without_optimising() {
         )),
         "{stdout}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The generator's 3D problem `spatial_6_9` of seed 6 drawn after 67 planar problems, with the defaults: its straight-line path runs through an obstacle, and from k ≈ 0.02
