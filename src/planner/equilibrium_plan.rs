@@ -39,6 +39,11 @@ pub struct EquilibriumPlan {
     /// Why not, when not.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// Which check failed, when not executable: the kind of the failure [`Self::reason`]
+    /// starts with (these equilibria's own, not their retries', which
+    /// [`Self::retries`] lists).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<EquilibriaFailure>,
     /// Largest energy of the replayed shapes (case units).
     pub u_max: f64,
     /// `k` where it occurs.
@@ -125,9 +130,45 @@ pub struct FailedRetry {
     /// What the retry changed: `"replayed with contacts on chords"`, `"along the end's pose
     /// line lifted 0.3 L"`, … (a retry of a retry names both, the first one first).
     pub attempt: String,
+    /// Which check its equilibria failed.
+    pub failure: EquilibriaFailure,
     /// Why its equilibria are no plan.
     pub reason: String,
 }
+
+/// Which check keeps replayed equilibria from being a plan ([`EquilibriumPlan::failure`],
+/// [`FailedRetry::failure`]); in reports, in snake case (`"snaps_through"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EquilibriaFailure {
+    /// The replay did not run.
+    NotRun,
+    /// A static solve of the replay did not converge.
+    NotConverged,
+    /// The replayed shape jumps between neighbouring `k` however finely the step is halved.
+    SnapsThrough,
+    /// A replayed shape is unstable.
+    Unstable,
+    /// The replay ends on another equilibrium of the goal pose than the goal shape.
+    EndsElsewhere,
+    /// A replayed shape comes inside an obstacle between the static solve's contact points.
+    EntersObstacle,
+    /// A replayed shape crosses itself.
+    CrossesItself,
+    /// The confirmation replay, on twice the steps, fails one of these checks or reaches other
+    /// shapes.
+    Confirmation,
+    /// The start pose's static solve under the retry's contacts did not converge.
+    StartNotConverged,
+    /// The plan made again to the equilibrium of the goal pose the replay reached is not
+    /// executable (the reason is its verdict).
+    PlannedAgain,
+    /// The run was interrupted.
+    Interrupted,
+}
+
+/// A failed check: which, and the reason for a reader.
+type Failed = (EquilibriaFailure, String);
 
 /// Another equilibrium of the goal pose that replayed equilibria reached
 /// ([`EquilibriumPlan::reached_goals`]), and along which trajectory.
@@ -142,16 +183,23 @@ pub(crate) struct Reached {
 }
 
 impl EquilibriumPlan {
-    /// Adds to [`Self::reason`] why a second attempt (`attempt`: what it changed) failed too.
-    pub(super) fn retry_failed(&mut self, attempt: &str, why: &str) {
+    /// Adds to [`Self::reason`] why a second attempt (`attempt`: what it changed) failed too:
+    /// `why`, a failure of the check `failure`.
+    pub(super) fn retry_failed(&mut self, attempt: &str, failure: EquilibriaFailure, why: &str) {
         self.add_retry(
             attempt,
             why,
             vec![FailedRetry {
                 attempt: attempt.into(),
+                failure,
                 reason: why.into(),
             }],
         );
+    }
+
+    /// Sets [`Self::reason`] and [`Self::failure`] to `failed` (both `None` for `None`).
+    fn set_failure(&mut self, failed: Option<Failed>) {
+        (self.failure, self.reason) = failed.unzip();
     }
 
     /// Adds `why` to [`Self::reason`] and `listed` to [`Self::retries`].
@@ -182,11 +230,12 @@ impl EquilibriumPlan {
         if let Some(why) = &retry.reason {
             let own = FailedRetry {
                 attempt: attempt.into(),
+                failure: retry.failure.unwrap_or(EquilibriaFailure::Interrupted),
                 reason: retry.own_reason().unwrap_or(why).into(),
             };
             let theirs = retry.retries.iter().map(|r| FailedRetry {
                 attempt: format!("{attempt}, {}", r.attempt),
-                reason: r.reason.clone(),
+                ..r.clone()
             });
             self.add_retry(attempt, why, std::iter::once(own).chain(theirs).collect());
         }
@@ -274,35 +323,39 @@ pub fn k_list(ks: &[f64]) -> String {
 /// What keeps a replay's shapes from being a plan, if anything: the first failing check of
 /// [`EquilibriumPlan::executable`] other than the confirmation. A replay may end on `ends_on`
 /// (positions, units of L: another equilibrium of the goal pose) instead of the goal shape.
-fn failure(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<String> {
+fn failure(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<Failed> {
     failure_on_the_way(first).or_else(|| ends_elsewhere(first, ends_on))
 }
 
 /// The checks of [`failure`] before the goal: every solve converged, nothing snaps, every shape
 /// is stable.
-fn failure_on_the_way(first: &Replay) -> Option<String> {
+fn failure_on_the_way(first: &Replay) -> Option<Failed> {
+    use EquilibriaFailure::*;
     let ks = |f: &dyn Fn(&super::replay::ReplayStep) -> bool| -> Vec<f64> {
         first.steps.iter().filter(|s| f(s)).map(|s| s.k).collect()
     };
     if first.steps.is_empty() {
-        return Some("the replay did not run".into());
+        return Some((NotRun, "the replay did not run".into()));
     }
     if !first.all_converged {
-        return Some(format!(
-            "replay solves did not converge at k = {}",
-            k_list(&ks(&|s| !s.converged))
+        let at = k_list(&ks(&|s| !s.converged));
+        return Some((
+            NotConverged,
+            format!("replay solves did not converge at k = {at}"),
         ));
     }
     if !first.snaps.is_empty() {
-        return Some(format!(
-            "the replay snaps through at k = {}",
-            k_list(&first.snaps)
+        let at = k_list(&first.snaps);
+        return Some((
+            SnapsThrough,
+            format!("the replay snaps through at k = {at}"),
         ));
     }
     if !first.all_stable {
-        return Some(format!(
-            "replayed shapes are unstable at k = {}",
-            k_list(&ks(&|s| s.stable == Some(false)))
+        let at = k_list(&ks(&|s| s.stable == Some(false)));
+        return Some((
+            Unstable,
+            format!("replayed shapes are unstable at k = {at}"),
         ));
     }
     None
@@ -310,7 +363,7 @@ fn failure_on_the_way(first: &Replay) -> Option<String> {
 
 /// Where the replay's last shape is not the goal shape (nor within the tolerance of `ends_on`,
 /// where given): why (the goal pose holds another equilibrium there).
-fn ends_elsewhere(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<String> {
+fn ends_elsewhere(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<Failed> {
     let on_other = |p: &[[f64; 3]]| {
         first
             .steps
@@ -318,9 +371,12 @@ fn ends_elsewhere(first: &Replay, ends_on: Option<&[[f64; 3]]>) -> Option<String
             .is_some_and(|s| s.k == 1.0 && max_distance(&s.positions, p) <= first.tolerance)
     };
     (first.end_deviation_over_l > first.tolerance && !ends_on.is_some_and(on_other)).then(|| {
-        format!(
-            "the replay ends {:.3e} L from the goal shape: the goal pose holds another equilibrium there",
-            first.end_deviation_over_l
+        (
+            EquilibriaFailure::EndsElsewhere,
+            format!(
+                "the replay ends {:.3e} L from the goal shape: the goal pose holds another equilibrium there",
+                first.end_deviation_over_l
+            ),
         )
     })
 }
@@ -333,7 +389,7 @@ fn penetration(
     planner: &Planner,
     fine: &Model,
     replay: &Replay,
-) -> (Option<String>, Option<f64>, bool) {
+) -> (Option<Failed>, Option<f64>, bool) {
     let (worst, self_gap) = super::verify::shapes_clearance(
         fine,
         &planner.obstacles,
@@ -347,9 +403,12 @@ fn penetration(
     let min_clearance = deepest.map(|w| w.clearance);
     if let Some(w) = deepest.filter(|w| w.clearance < -tol) {
         return (
-            Some(format!(
-                "a replayed shape comes {:.3e} inside obstacle '{}' at k = {:.4}, s = {:.4} (between the static solve's contact points)",
-                -w.clearance, w.obstacle, w.k, w.s
+            Some((
+                EquilibriaFailure::EntersObstacle,
+                format!(
+                    "a replayed shape comes {:.3e} inside obstacle '{}' at k = {:.4}, s = {:.4} (between the static solve's contact points)",
+                    -w.clearance, w.obstacle, w.k, w.s
+                ),
             )),
             min_clearance,
             true,
@@ -357,8 +416,9 @@ fn penetration(
     }
     if let Some((g, k)) = self_gap.filter(|(g, _)| *g < -tol) {
         return (
-            Some(format!(
-                "a replayed shape crosses itself (gap {g:.3e}) at k = {k:.4}"
+            Some((
+                EquilibriaFailure::CrossesItself,
+                format!("a replayed shape crosses itself (gap {g:.3e}) at k = {k:.4}"),
             )),
             min_clearance,
             false,
@@ -391,9 +451,8 @@ impl Planner {
         let on_the_way = failure_on_the_way(first);
         let mut plan = EquilibriumPlan {
             executable: false,
-            reason: on_the_way
-                .clone()
-                .or_else(|| ends_elsewhere(first, ends_on)),
+            reason: None,
+            failure: None,
             u_max,
             k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
             min_clearance: first.min_clearance,
@@ -423,9 +482,14 @@ impl Planner {
             dips: false,
             reached_goals: Vec::new(),
         };
+        plan.set_failure(
+            on_the_way
+                .clone()
+                .or_else(|| ends_elsewhere(first, ends_on)),
+        );
         if plan.reason.is_none() {
             let (why, clearance, dips) = penetration(self, fine, first);
-            plan.reason = why;
+            plan.set_failure(why);
             plan.min_clearance = clearance;
             plan.dips = dips;
         } else if on_the_way.is_none() {
@@ -447,7 +511,9 @@ impl Planner {
             }
         }
         if plan.reason.is_some() || self.stopped() {
-            plan.reason.get_or_insert_with(|| "interrupted".into());
+            if plan.reason.is_none() {
+                plan.set_failure(Some((EquilibriaFailure::Interrupted, "interrupted".into())));
+            }
             return plan;
         }
         let opts = ReplayOptions {
@@ -467,7 +533,7 @@ impl Planner {
             &self.stop,
         );
         if self.stopped() {
-            plan.reason = Some("interrupted".into());
+            plan.set_failure(Some((EquilibriaFailure::Interrupted, "interrupted".into())));
             return plan;
         }
         // The largest distance between the replays' shapes at the k they share.
@@ -489,9 +555,9 @@ impl Planner {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        plan.reason = failure(&second, ends_on)
+        let confirmation = failure(&second, ends_on)
             .or(why)
-            .map(|r| format!("the confirmation replay on {} steps: {r}", opts.steps))
+            .map(|(_, r)| format!("the confirmation replay on {} steps: {r}", opts.steps))
             .or_else(|| {
                 (worst > first.tolerance).then(|| {
                     format!(
@@ -500,6 +566,7 @@ impl Planner {
                     )
                 })
             });
+        plan.set_failure(confirmation.map(|r| (EquilibriaFailure::Confirmation, r)));
         plan.executable = plan.reason.is_none();
         plan
     }
@@ -507,11 +574,13 @@ impl Planner {
 
 #[cfg(test)]
 impl EquilibriumPlan {
-    /// Equilibria along the optimal path's trajectory that are no plan, for `reason`.
-    pub(crate) fn failed(reason: &str) -> EquilibriumPlan {
+    /// Equilibria along the optimal path's trajectory that are no plan: `reason`, a failure
+    /// of the check `failure`.
+    pub(crate) fn failed(failure: EquilibriaFailure, reason: &str) -> EquilibriumPlan {
         EquilibriumPlan {
             executable: false,
             reason: Some(reason.into()),
+            failure: Some(failure),
             u_max: 1.0,
             k_at_u_max: 1.0,
             min_clearance: None,
@@ -540,22 +609,25 @@ impl EquilibriumPlan {
 mod tests {
     use super::{EquilibriumPlan, FailedRetry};
 
-    /// Each failed retry is listed with what it changed and why it failed, a retry's own
-    /// retries after it with both names; the reason holds the same as one sentence, after the
-    /// plan's own failure, which stays apart.
+    /// Each failed retry is listed with what it changed, which check failed and why, a
+    /// retry's own retries after it with both names; the reason holds the same as one
+    /// sentence, after the plan's own failure, which stays apart with its kind.
     #[test]
     fn failed_retries_are_listed_one_by_one() {
-        let mut plan = EquilibriumPlan::failed("the replay ends elsewhere");
+        use super::EquilibriaFailure::*;
+        let mut plan = EquilibriumPlan::failed(EndsElsewhere, "the replay ends elsewhere");
         assert_eq!(plan.own_reason(), Some("the replay ends elsewhere"));
         plan.retry_failed(
             "replayed with contacts on chords",
+            SnapsThrough,
             "the replay snaps through",
         );
-        let mut line = EquilibriumPlan::failed("solves did not converge");
-        line.retry_failed("replayed on chords", "a shape dips");
+        let mut line = EquilibriumPlan::failed(NotConverged, "solves did not converge");
+        line.retry_failed("replayed on chords", EntersObstacle, "a shape dips");
         plan.retry_failed_as("along the end's pose line", &line);
-        let listed = |attempt: &str, reason: &str| FailedRetry {
+        let listed = |attempt: &str, failure, reason: &str| FailedRetry {
             attempt: attempt.into(),
+            failure,
             reason: reason.into(),
         };
         assert_eq!(
@@ -563,16 +635,23 @@ mod tests {
             [
                 listed(
                     "replayed with contacts on chords",
+                    SnapsThrough,
                     "the replay snaps through"
                 ),
-                listed("along the end's pose line", "solves did not converge"),
+                listed(
+                    "along the end's pose line",
+                    NotConverged,
+                    "solves did not converge"
+                ),
                 listed(
                     "along the end's pose line, replayed on chords",
+                    EntersObstacle,
                     "a shape dips"
                 ),
             ]
         );
         assert_eq!(plan.own_reason(), Some("the replay ends elsewhere"));
+        assert_eq!(plan.failure, Some(EndsElsewhere));
         assert_eq!(
             plan.reason.as_deref(),
             Some(
@@ -580,13 +659,15 @@ mod tests {
                  along the end's pose line: solves did not converge; replayed on chords: a shape dips"
             )
         );
-        // Not serialised where nothing was retried.
-        let json = serde_json::to_value(EquilibriumPlan::failed("x")).unwrap();
+        // Not serialised where nothing was retried; kinds in snake case.
+        let json = serde_json::to_value(EquilibriumPlan::failed(Unstable, "x")).unwrap();
         assert!(json.get("retries").is_none());
-        assert_eq!(
-            serde_json::to_value(&plan).unwrap()["retries"][2]["reason"],
-            "a shape dips"
-        );
+        assert_eq!(json["failure"], "unstable");
+        let json = serde_json::to_value(&plan).unwrap();
+        assert_eq!(json["retries"][2]["reason"], "a shape dips");
+        assert_eq!(json["retries"][2]["failure"], "enters_obstacle");
+        assert_eq!(json["retries"][0]["failure"], "snaps_through");
+        assert_eq!(json["failure"], "ends_elsewhere");
     }
 
     /// Nine decimals at most, no trailing zeros, and no rounding residue of a sum of steps.

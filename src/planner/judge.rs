@@ -239,7 +239,11 @@ impl Planner {
                     );
                     let Some(start) = replay::start_under(&held, &self.start, &self.static_options)
                     else {
-                        ep.retry_failed(&what, "the start pose's solve did not converge");
+                        ep.retry_failed(
+                            &what,
+                            equilibrium_plan::EquilibriaFailure::StartNotConverged,
+                            "the start pose's solve did not converge",
+                        );
                         break;
                     };
                     let mut pl = self.clone();

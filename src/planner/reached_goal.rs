@@ -19,7 +19,7 @@
 //! the plan (with `replan_failed`), else the first plan is reported, with what the second met.
 
 use super::end_shapes::{on_chords_if_dipping, solve_warm_from};
-use super::equilibrium_plan::Reached;
+use super::equilibrium_plan::{EquilibriaFailure, Reached};
 use super::judge::Judged;
 use super::observer::{PlanObserver, RecordedShapes, Recorder, flush};
 use super::path::DeformationPath;
@@ -174,6 +174,7 @@ impl Planner {
                     "planned again to the equilibrium of the goal pose the replay ends on ({:.3e} L from the goal shape)",
                     reached.distance_over_l
                 ),
+                EquilibriaFailure::PlannedAgain,
                 &again.verdict().to_string(),
             );
         }
@@ -318,7 +319,7 @@ fn routes(reached: &[Reached]) -> Vec<Reached> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::equilibrium_plan::{EquilibriumPlan, Reached};
+    use super::super::equilibrium_plan::{EquilibriaFailure, EquilibriumPlan, Reached};
     use super::super::pose_line::Detour;
 
     /// Lifted by `lift`, not moved aside.
@@ -334,7 +335,10 @@ mod tests {
                 trajectory: "optimal_path",
                 line: None,
             }],
-            ..EquilibriumPlan::failed("the replay ends elsewhere")
+            ..EquilibriumPlan::failed(
+                EquilibriaFailure::EndsElsewhere,
+                "the replay ends elsewhere",
+            )
         }
     }
 

@@ -723,6 +723,20 @@ fn plan_prints_documented_json_and_exit_codes() {
         err.contains(&format!("; {} retries failed too (", retries.len())),
         "{err}"
     );
+    assert_eq!(v["equilibrium_plan"]["failure"], "snaps_through");
+    // Each names the check it failed, which its reason describes, and the message counts
+    // them by that kind.
+    let describes = |failure: &str| match failure {
+        "not_converged" => "replay solves did not converge",
+        "snaps_through" => "the replay snaps through",
+        "unstable" => "replayed shapes are unstable",
+        "ends_elsewhere" => "the replay ends ",
+        "enters_obstacle" => "a replayed shape comes ",
+        "crosses_itself" => "a replayed shape crosses itself",
+        "confirmation" => "the confirmation replay",
+        "start_not_converged" => "the start pose's solve did not converge",
+        other => panic!("unexpected failure kind {other}"),
+    };
     for r in retries {
         let (attempt, reason) = (
             r["attempt"].as_str().unwrap(),
@@ -732,6 +746,23 @@ fn plan_prints_documented_json_and_exit_codes() {
             why.contains(&format!("{attempt}: {reason}")),
             "{r} not in {why}"
         );
+        assert!(
+            reason.starts_with(describes(r["failure"].as_str().unwrap())),
+            "{r}"
+        );
+    }
+    let count = |kind: &str| retries.iter().filter(|r| r["failure"] == kind).count();
+    for (kind, named) in [
+        ("snaps_through", "snap through"),
+        ("not_converged", "stop converging"),
+        (
+            "ends_elsewhere",
+            "end on another equilibrium of the goal pose",
+        ),
+    ] {
+        if count(kind) > 0 {
+            assert!(err.contains(&format!("{} {named}", count(kind))), "{err}");
+        }
     }
     // The summary lists them one a line.
     let (_, summary, _) = plan_text(snap.to_str().unwrap());

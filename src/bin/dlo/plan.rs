@@ -447,23 +447,20 @@ fn equilibria_not_a_plan(result: &dlo_planner::planner::PlanResult) -> String {
 
 /// How the retries `retries` failed, counted by kind: `5 snap through, 2 stop converging`.
 fn retry_outcomes(retries: &[dlo_planner::planner::equilibrium_plan::FailedRetry]) -> String {
-    // (The first that a reason mentions.)
+    use dlo_planner::planner::equilibrium_plan::EquilibriaFailure::*;
     let kinds = [
-        ("the confirmation replay", "fail their confirmation replay"),
-        ("the replay snaps through", "snap through"),
-        ("replay solves did not converge", "stop converging"),
-        (
-            "the replay ends",
-            "end on another equilibrium of the goal pose",
-        ),
-        ("a replayed shape comes", "dip into an obstacle"),
-        ("a replayed shape crosses itself", "cross themselves"),
+        (Confirmation, "fail their confirmation replay"),
+        (SnapsThrough, "snap through"),
+        (NotConverged, "stop converging"),
+        (EndsElsewhere, "end on another equilibrium of the goal pose"),
+        (EntersObstacle, "dip into an obstacle"),
+        (CrossesItself, "cross themselves"),
     ];
     let mut counts = vec![0usize; kinds.len() + 1];
     for r in retries {
         let i = kinds
             .iter()
-            .position(|(p, _)| r.reason.contains(p))
+            .position(|(f, _)| *f == r.failure)
             .unwrap_or(kinds.len());
         counts[i] += 1;
     }
