@@ -144,9 +144,7 @@ impl Planner {
             // Along a pose line or an optimised course, the replayed equilibria's end poses.
             result.trajectory = match route.trajectory {
                 t if optimised || t == "pose_line" => {
-                    let shapes: Vec<(f64, Vec<f64>)> =
-                        j.replay.steps.iter().map(|s| (s.k, s.a.clone())).collect();
-                    Trajectory::of_shapes(model, &self.start.a, &shapes)
+                    Trajectory::of_replay(model, &self.start.a, &j.replay)
                 }
                 "straight_path" => {
                     let path = self.path();

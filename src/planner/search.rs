@@ -343,9 +343,7 @@ impl Planner {
             .as_ref()
             .is_some_and(|e| e.trajectory == "pose_line" || e.pose_terms.is_some());
         let trajectory = if along_line {
-            let shapes: Vec<(f64, Vec<f64>)> =
-                rep.steps.iter().map(|s| (s.k, s.a.clone())).collect();
-            trajectory::Trajectory::of_shapes(model, &self.start.a, &shapes)
+            trajectory::Trajectory::of_replay(model, &self.start.a, &rep)
         } else {
             trajectory::Trajectory::along(model, traj_path, traj_z, &ks)
         };

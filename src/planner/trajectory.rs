@@ -216,6 +216,15 @@ impl Trajectory {
         Self::of_shapes(model, &shape_at(0.0), &shapes)
     }
 
+    /// The trajectory of the controlled end of a replay's shapes, with the held end's pose from
+    /// shape `first`: the end poses that hold the replayed equilibria, which the gripper
+    /// follows along a pose line or an optimised course.
+    pub fn of_replay(model: &Model, first: &[f64], replay: &super::replay::Replay) -> Trajectory {
+        let shapes: Vec<(f64, Vec<f64>)> =
+            replay.steps.iter().map(|s| (s.k, s.a.clone())).collect();
+        Self::of_shapes(model, first, &shapes)
+    }
+
     /// The trajectory of the controlled end of the shapes `(k, a)` (increasing `k`), with the
     /// held end's pose from shape `first`.
     pub fn of_shapes(model: &Model, first: &[f64], shapes: &[(f64, Vec<f64>)]) -> Trajectory {
