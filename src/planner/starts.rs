@@ -287,6 +287,22 @@ impl Planner {
                     break 'attempts;
                 }
                 if judge(&runs, kind == Attempt::Quick, observer) {
+                    // The case's own plan is executable, but a quick plan that peaks inside the
+                    // path (neither tracked nor replayed) is lower: lifted and tracked as a
+                    // plan at the bound is, it is judged too, and the better executable one
+                    // is the plan.
+                    if kind == Attempt::Own
+                        && !self.time_up()
+                        && let Some(lift) = self.lower_quick(&runs)
+                    {
+                        attempt += 1;
+                        let run = self.run_lifted(lift, attempt * starts, fine, observer);
+                        let repeat = run.repeat;
+                        runs.push(run);
+                        if !repeat && !self.stopped() {
+                            judge(&runs, false, observer);
+                        }
+                    }
                     break 'attempts;
                 }
                 // A plan of this group at the lower bound, collision-free but not executable:
@@ -354,6 +370,54 @@ impl Planner {
             repeat: plan.run.z == z,
             plan,
         }
+    }
+
+    /// With `lift` on, a quick plan that peaks inside the path, converged and collision-free,
+    /// whose `U_max` on the verification grid is lower than every own plan's by more than the
+    /// energy gap tolerance (the lowest such): lifted to the first fallback count (none
+    /// without one).
+    fn lower_quick(&self, runs: &[StartPlan]) -> Option<Lift> {
+        if !self.settings.lift {
+            return None;
+        }
+        let tol = self.collision_tolerance();
+        let own = runs
+            .iter()
+            .filter(|r| r.attempt == Attempt::Own)
+            .map(|r| r.plan.verification.u_max)
+            .fold(f64::INFINITY, f64::min);
+        let gap = self.settings.energy_gap_tolerance;
+        let r = runs
+            .iter()
+            .filter(|r| {
+                let v = &r.plan;
+                r.attempt == Attempt::Quick
+                    && !v.run.settled
+                    && v.run.status == crate::optim::AlStatus::Converged
+                    && v.verification.collision_free(tol)
+                    && v.verification.u_max < own - gap * own.abs()
+            })
+            .min_by(|a, b| {
+                a.plan
+                    .verification
+                    .u_max
+                    .total_cmp(&b.plan.verification.u_max)
+            })?;
+        let terms = *self
+            .settings
+            .fallback_terms(self.base.model.layout.spatial)
+            .first()?;
+        let terms = terms.max(r.terms);
+        let mut pl = self.with_terms(terms);
+        pl.settings.travel_weight = r.travel_weight;
+        pl.settings.swept_clearance = Some(r.swept_clearance);
+        let v = &r.plan;
+        Some(Lift {
+            z: DeformationPath::lift(&v.run.z, r.terms, terms),
+            planner: pl,
+            violation: v.run.violation,
+            samples: Arc::clone(&v.run.samples),
+        })
     }
 
     /// The lift of the best of `group`'s plans (an attempt of kind `kind`) when it is

@@ -423,7 +423,8 @@ fn paper_replay_coincides_from_other_starts() {
 /// seed 14 the first start's plan is estimated at 2.48 %, so the second start (seed 15) runs and
 /// is chosen; it is the single start of seed 15 bit for bit — when only an optimal path that
 /// coincides counts (`"equilibrium_plans": false`). By default the first start's replayed
-/// equilibria are a plan, and the second start does not run.
+/// equilibria are a plan, and the second start does not run; with the fallback counts, the
+/// quick plan, lower than the first start's, is then lifted and tracked, and is the plan.
 /// (A quick start runs before them on a planar rod; on this case its plan peaks inside the
 /// path, so it is not replayed and does not count.)
 #[test]
@@ -446,6 +447,17 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     assert_eq!((after_quick(&eq).0.len(), eq.starts_not_run), (1, 1));
     assert!(!eq.replay.coincide);
     assert_eq!(eq.executed_path(), Some("equilibria"));
+    // With the default fallback counts (6 and 8 path terms; left out above), the quick plan,
+    // which peaks inside the path below the own plan (5.28 against 5.39 measured) and so was
+    // neither tracked nor replayed, is then lifted to six path terms and tracked: it
+    // coincides with its replay at a lower U_max, and is the plan.
+    let lq = paper_with(serde_json::json!({ "seed": 14, "fallback_path_terms": [6, 8] }));
+    let kinds: Vec<Attempt> = lq.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
+    assert_eq!(lq.chosen_start, Some(lq.starts[2].start));
+    assert!(lq.replay.coincide);
+    assert_eq!(lq.executed_path(), Some("optimal"));
+    assert!(lq.u_max < eq.u_max, "{} vs {}", lq.u_max, eq.u_max);
     // Only the optimal path as planned counts (`"equilibrium_plans": false`): the second runs.
     let r5 = paper_with(serde_json::json!({ "seed": 14, "equilibrium_plans": false }));
     let (own5, chosen5) = after_quick(&r5);

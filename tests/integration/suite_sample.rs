@@ -282,6 +282,46 @@ fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     );
 }
 
+/// The suite's planar problem `planar_4_18` (seed 4), planned with the defaults: the quick
+/// plan peaks inside the path, so it is neither tracked nor replayed, and the case's own plan
+/// is executable, but the quick plan is collision-free and lower on the verification grid.
+/// Lifted to the first fallback count's path terms and tracked, it is judged too, and being
+/// executable at a lower U_max it is the plan. Without the lift (`"lift": false`) the own plan
+/// is, at a higher U_max. The plan is checked on 801 values of k and 1024 intervals in s:
+/// clearance at least −1e-6 L, largest energy the reported U_max to 1e-3.
+#[test]
+fn a_lower_quick_plan_than_the_executable_own_plan_is_lifted_and_chosen() {
+    use dlo_planner::planner::Attempt;
+    let (p, r) = suite_planar_plan_of(4, 18);
+    let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
+    let (quick, own, lifted) = (&r.starts[0], &r.starts[1], &r.starts[2]);
+    assert!(quick.collision_free && quick.equilibrium_deviation.is_none());
+    assert!(quick.u_max < own.u_max, "{quick:?} {own:?}");
+    assert_eq!(r.chosen_start, Some(lifted.start));
+    assert_eq!(r.verdict().to_string(), "executable");
+    assert!(r.u_max < own.u_max, "{} vs {}", r.u_max, own.u_max);
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    assert!(
+        (v.u_max - r.u_max).abs() <= 1e-3 * r.u_max,
+        "{} vs {}",
+        v.u_max,
+        r.u_max
+    );
+    let (_, unlifted) = suite_planar_plan_with(4, 18, serde_json::json!({ "lift": false }));
+    let kinds: Vec<Attempt> = unlifted.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Own]);
+    assert_eq!(unlifted.verdict().to_string(), "executable");
+    assert!(
+        unlifted.u_max > r.u_max * 1.01,
+        "{} vs {}",
+        unlifted.u_max,
+        r.u_max
+    );
+}
+
 /// The suite's planar problem `planar_1_11` (seed 1), planned with the defaults: its optimal
 /// path is collision-free but its replay departs by 4.9 % of L, so the plan the gripper
 /// executes is the replayed equilibria along the optimal path's trajectory. Checked
