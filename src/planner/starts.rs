@@ -53,6 +53,8 @@ struct Lift {
     z: Vec<f64>,
     violation: f64,
     samples: Arc<(Vec<f64>, Option<Vec<f64>>)>,
+    /// Objective evaluations it may use, its refinement reruns and their tracking included.
+    budget: usize,
 }
 
 /// Judges the plans so far (told whether they come from the quick attempt): true when they are
@@ -340,8 +342,12 @@ impl Planner {
             z,
             violation,
             samples,
+            budget,
         } = lift;
-        let lifted = self.budgeted(planner);
+        let lifted = Planner {
+            budget: Some(budget),
+            ..planner
+        };
         // No sharpness stage: the source's converged path is taken as their result, on its
         // samples, with its multipliers.
         let (ks, lambda) = &*samples;
@@ -375,7 +381,7 @@ impl Planner {
     /// With `lift` on, a quick plan that peaks inside the path, converged and collision-free,
     /// whose `U_max` on the verification grid is lower than every own plan's by more than the
     /// energy gap tolerance (the lowest such): lifted to the first fallback count (none
-    /// without one).
+    /// without one), on a tenth of `fallback_evaluations`.
     fn lower_quick(&self, runs: &[StartPlan]) -> Option<Lift> {
         if !self.settings.lift {
             return None;
@@ -407,17 +413,27 @@ impl Planner {
             .settings
             .fallback_terms(self.base.model.layout.spatial)
             .first()?;
-        let terms = terms.max(r.terms);
+        // An executable plan is in hand: the lift is a refinement of it, on a tenth of a
+        // fallback's budget (those that made a lower plan executable on the generated suite
+        // took 17-66 evaluations; those that failed, thousands in refinement reruns).
+        let budget = self.settings.fallback_evaluations / 10;
+        Some(self.lift_of(r, terms.max(r.terms), budget))
+    }
+
+    /// `r`'s path lifted to `terms` path terms, with its planner's settings, on `budget`
+    /// evaluations.
+    fn lift_of(&self, r: &StartPlan, terms: usize, budget: usize) -> Lift {
         let mut pl = self.with_terms(terms);
         pl.settings.travel_weight = r.travel_weight;
         pl.settings.swept_clearance = Some(r.swept_clearance);
         let v = &r.plan;
-        Some(Lift {
+        Lift {
             z: DeformationPath::lift(&v.run.z, r.terms, terms),
             planner: pl,
             violation: v.run.violation,
             samples: Arc::clone(&v.run.samples),
-        })
+            budget,
+        }
     }
 
     /// The lift of the best of `group`'s plans (an attempt of kind `kind`) when it is
@@ -442,15 +458,7 @@ impl Planner {
         if !liftable {
             return None;
         }
-        let mut pl = self.with_terms(terms);
-        pl.settings.travel_weight = r.travel_weight;
-        pl.settings.swept_clearance = Some(r.swept_clearance);
-        Some(Lift {
-            z: DeformationPath::lift(&v.run.z, r.terms, terms),
-            planner: pl,
-            violation: v.run.violation,
-            samples: Arc::clone(&v.run.samples),
-        })
+        Some(self.lift_of(r, terms, self.settings.fallback_evaluations))
     }
 }
 
