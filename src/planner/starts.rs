@@ -289,10 +289,12 @@ impl Planner {
                     break 'attempts;
                 }
                 if judge(&runs, kind == Attempt::Quick, observer) {
-                    // The case's own plan is executable, but a quick plan that peaks inside the
-                    // path (neither tracked nor replayed) is lower: lifted and tracked as a
-                    // plan at the bound is, it is judged too, and the better executable one
-                    // is the plan.
+                    // The case's own attempt ends the search (a plan is executable; or, rarely,
+                    // the replay leaves the start shape and none can be, which the lift's
+                    // judgement finds again). Where a quick plan that peaks inside the path
+                    // (neither tracked nor replayed) is lower, it is lifted and tracked as a
+                    // plan at the bound is and judged too, and the better executable plan is
+                    // the plan.
                     if kind == Attempt::Own
                         && !self.time_up()
                         && let Some(lift) = self.lower_quick(&runs)
