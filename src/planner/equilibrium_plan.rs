@@ -183,6 +183,37 @@ pub(crate) struct Reached {
 }
 
 impl EquilibriumPlan {
+    /// Equilibria along the optimal path's trajectory before any check: not executable, no
+    /// reason yet, no replayed shape (`u_max` −∞), contacts at the sample points, nothing
+    /// retried.
+    fn unchecked() -> EquilibriumPlan {
+        EquilibriumPlan {
+            executable: false,
+            reason: None,
+            failure: None,
+            u_max: f64::NEG_INFINITY,
+            k_at_u_max: 0.0,
+            min_clearance: None,
+            max_contact_force: 0.0,
+            k_at_max_contact_force: 0.0,
+            confirmation_steps: None,
+            confirmation_deviation_over_l: None,
+            contact: "points",
+            contact_margin: None,
+            contact_samples: None,
+            trajectory: "optimal_path",
+            lift_over_l: None,
+            side_over_l: None,
+            pose_terms: None,
+            course_u_max: None,
+            optimal_path_not_executable: None,
+            retries: Vec::new(),
+            own: None,
+            dips: false,
+            reached_goals: Vec::new(),
+        }
+    }
+
     /// Adds to [`Self::reason`] why a second attempt (`attempt`: what it changed) failed too:
     /// `why`, a failure of the check `failure`.
     pub(super) fn retry_failed(&mut self, attempt: &str, failure: EquilibriaFailure, why: &str) {
@@ -450,16 +481,11 @@ impl Planner {
         let ends_on = self.ends_on.as_deref().map(Vec::as_slice);
         let on_the_way = failure_on_the_way(first);
         let mut plan = EquilibriumPlan {
-            executable: false,
-            reason: None,
-            failure: None,
             u_max,
             k_at_u_max: first.steps.get(iu).map_or(0.0, |s| s.k),
             min_clearance: first.min_clearance,
             max_contact_force: first.max_contact_force,
             k_at_max_contact_force: first.k_at_max_contact_force,
-            confirmation_steps: None,
-            confirmation_deviation_over_l: None,
             contact: if base
                 .constraints
                 .iter()
@@ -469,18 +495,7 @@ impl Planner {
             } else {
                 "points"
             },
-            contact_margin: None,
-            contact_samples: None,
-            trajectory: "optimal_path",
-            lift_over_l: None,
-            side_over_l: None,
-            pose_terms: None,
-            course_u_max: None,
-            optimal_path_not_executable: None,
-            retries: Vec::new(),
-            own: None,
-            dips: false,
-            reached_goals: Vec::new(),
+            ..EquilibriumPlan::unchecked()
         };
         plan.set_failure(
             on_the_way
@@ -578,29 +593,11 @@ impl EquilibriumPlan {
     /// of the check `failure`.
     pub(crate) fn failed(failure: EquilibriaFailure, reason: &str) -> EquilibriumPlan {
         EquilibriumPlan {
-            executable: false,
             reason: Some(reason.into()),
             failure: Some(failure),
             u_max: 1.0,
             k_at_u_max: 1.0,
-            min_clearance: None,
-            max_contact_force: 0.0,
-            k_at_max_contact_force: 0.0,
-            confirmation_steps: None,
-            confirmation_deviation_over_l: None,
-            contact: "points",
-            contact_margin: None,
-            contact_samples: None,
-            trajectory: "optimal_path",
-            lift_over_l: None,
-            side_over_l: None,
-            pose_terms: None,
-            course_u_max: None,
-            optimal_path_not_executable: None,
-            retries: Vec::new(),
-            own: None,
-            dips: false,
-            reached_goals: Vec::new(),
+            ..EquilibriumPlan::unchecked()
         }
     }
 }
