@@ -13,6 +13,13 @@ use crate::optim::{AlOptions, augmented_lagrangian_observed};
 /// fraction closer to their equilibria.
 const TRACK_PROGRESS: f64 = 0.1;
 
+/// Equilibrium tracking does not start when the sampled shapes lie farther than this (units of
+/// L) from their equilibria: those equilibria are on another branch than the path's shapes (the
+/// march along the samples has snapped through, or the route passes where no equilibrium
+/// holds), and pulling the path towards them crawls (the pull fights the obstacle rows at
+/// penalties up to the cap) and seldom brings the shapes near (docs/notes/speed-alternatives.md).
+const TRACK_FAR: f64 = 0.25;
+
 impl Planner {
     /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
     /// result), with the stages' multiplier-method settings `al`; returns how many rounds ran,
@@ -49,7 +56,8 @@ impl Planner {
         }
         // Rounds stop early when the sampled shapes already lie within `equilibrium_stop` of
         // the coincidence tolerance from their equilibria, or when a round brought them less
-        // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it).
+        // than `TRACK_PROGRESS` closer (the route is then as executable as tracking makes it);
+        // none run when the shapes start farther than `TRACK_FAR` from them.
         let spatial = self.base.model.layout.spatial;
         let done = self.settings.tracking_stop(spatial) * self.settings.coincide_tolerance;
         let mut dev_prev = f64::INFINITY;
@@ -111,6 +119,11 @@ impl Planner {
                 };
                 kept = tracking_rounds - 1;
                 estimate = Some(dev_prev);
+                break;
+            }
+            // Equilibria on another branch: not tracked.
+            if tracking_rounds == 0 && dev > TRACK_FAR {
+                estimate = Some(dev);
                 break;
             }
             p.targets = Some(targets);
