@@ -8,7 +8,7 @@ use super::judge::Judged;
 use super::observer::{PathKind, PlanObserver, RecordedShapes, ShapeRecord};
 use super::result::{Attempt, PlanResult, PlanStatus, StartSummary, Timing};
 use super::start::{self, Verified};
-use super::starts::StartPlan;
+use super::starts::{Judgement, StartPlan};
 use super::verify::fine_model;
 use super::{Planner, clearance, pose_line, trajectory};
 use crate::optim::AlStatus;
@@ -36,23 +36,28 @@ impl Planner {
                 .filter(|&i| !runs[i].repeat && !judged.iter().any(|(j, _)| *j == i))
                 .max_by(|&i, &j| self.ranked(runs, i, j))
             else {
-                return false;
+                return Judgement::GoOn;
             };
             // A quick plan that peaks inside the path cannot end the search: not replayed yet.
             if quick && !runs[best].plan.verification.peaks_at_an_end() {
-                return false;
+                return Judgement::GoOn;
             }
             let j = self.judge(&runs[best], fine, observer);
             let (held, executable) = (j.replay.start_held(), j.executable);
             judged.push((best, j));
             if !held {
-                return true;
+                return Judgement::StartLeft;
             }
             // (A quick plan got here only if it attains the lower bound.)
-            if quick {
+            let found = if quick {
                 executable
             } else {
                 judged.iter().any(|(_, j)| j.executable)
+            };
+            if found {
+                Judgement::Executable
+            } else {
+                Judgement::GoOn
             }
         };
         let runs = self.run_starts(fine, observer, &mut judge);

@@ -57,9 +57,29 @@ struct Lift {
     budget: usize,
 }
 
-/// Judges the plans so far (told whether they come from the quick attempt): true when they are
-/// good enough to end the search.
-pub(super) type Judge<'a> = dyn FnMut(&[StartPlan], bool, &mut dyn PlanObserver) -> bool + 'a;
+/// Judges the plans so far (told whether they come from the quick attempt): whether they end
+/// the search, and why.
+pub(super) type Judge<'a> = dyn FnMut(&[StartPlan], bool, &mut dyn PlanObserver) -> Judgement + 'a;
+
+/// What the judgement of the plans so far says about the search.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Judgement {
+    /// No plan is good enough yet: the search goes on.
+    GoOn,
+    /// A plan is executable (after the quick attempt, only one that attains the lower bound on
+    /// `U_max` counts).
+    Executable,
+    /// The replay left the start shape at k = 0, which no path can change: no plan can be
+    /// executable.
+    StartLeft,
+}
+
+impl Judgement {
+    /// Whether the search ends here.
+    fn ends(self) -> bool {
+        self != Judgement::GoOn
+    }
+}
 
 /// Deterministic pseudo-random numbers in `[-1, 1]` (xorshift64*).
 fn noise(seed: u64, n: usize) -> Vec<f64> {
@@ -288,14 +308,14 @@ impl Planner {
                 if self.stopped() {
                     break 'attempts;
                 }
-                if judge(&runs, kind == Attempt::Quick, observer) {
-                    // The case's own attempt ends the search (a plan is executable; or, rarely,
-                    // the replay leaves the start shape and none can be, which the lift's
-                    // judgement finds again). Where a quick plan that peaks inside the path
-                    // (neither tracked nor replayed) is lower, it is lifted and tracked as a
-                    // plan at the bound is and judged too, and the better executable plan is
-                    // the plan.
+                let judgement = judge(&runs, kind == Attempt::Quick, observer);
+                if judgement.ends() {
+                    // Where the case's own attempt has an executable plan and a quick plan
+                    // that peaks inside the path (neither tracked nor replayed) is lower, that
+                    // plan is lifted and tracked as a plan at the bound is and judged too, and
+                    // the better executable plan is the plan.
                     if kind == Attempt::Own
+                        && judgement == Judgement::Executable
                         && !self.time_up()
                         && let Some(lift) = self.lower_quick(&runs)
                     {
@@ -320,7 +340,7 @@ impl Planner {
                     let run = self.run_lifted(lift, attempt * starts, fine, observer);
                     let repeat = run.repeat;
                     runs.push(run);
-                    if self.stopped() || (!repeat && judge(&runs, false, observer)) {
+                    if self.stopped() || (!repeat && judge(&runs, false, observer).ends()) {
                         break 'attempts;
                     }
                 }
