@@ -476,7 +476,9 @@ impl Planner {
             && v.run.settled
             && v.run.status == crate::optim::AlStatus::Converged
             && v.verification.collision_free(self.collision_tolerance())
-            && (kind == Attempt::Own || v.verification.peaks_at_an_end());
+            && (kind == Attempt::Own || v.verification.peaks_at_an_end())
+            // (Its equilibria on another branch: tracking would not start.)
+            && v.run.equilibrium_deviation.is_none_or(|d| d <= super::tracking::TRACK_FAR);
         if !liftable {
             return None;
         }

@@ -18,7 +18,7 @@ const TRACK_PROGRESS: f64 = 0.1;
 /// march along the samples has snapped through, or the route passes where no equilibrium
 /// holds), and pulling the path towards them crawls (the pull fights the obstacle rows at
 /// penalties up to the cap) and seldom brings the shapes near (docs/notes/speed-alternatives.md).
-const TRACK_FAR: f64 = 0.25;
+pub(super) const TRACK_FAR: f64 = 0.25;
 
 impl Planner {
     /// Runs the equilibrium-tracking rounds on `p` from the path `z` (the sharpness stages'
