@@ -6,8 +6,11 @@
 //! (an upper bound on `max u` by at most `ln(K+1)/β`) and `w ≥ 0` weighs the mean energy along
 //! the path (it makes the shapes away from the maximum equilibria too; docs/algorithms.md, step 4).
 //! With tracking targets `x̄_j` set (the equilibria the controlled end's poses produce, see
-//! [`crate::planner::Planner`]), `J` also has `(w_eq/2) · Σ_j mean_b |x_b(a(z,k_j)) − x̄_jb|²`,
-//! which pulls every sampled shape onto the equilibrium its own end pose gives.
+//! [`crate::planner::Planner`]), `J` also has `(w_eq/2) · Σ_j mean_b |r_jb|²` with
+//! `r_jb = x_b(a(z,k_j)) − x̄_jb`, which pulls every sampled shape onto the equilibrium its own
+//! end pose gives; with the targets' slopes set, `r_jb = x_b − x̄_jb − D_jb (P(a) − v_j)`
+//! follows the sample's end pose `P(a)` from the pose `v_j` the target was solved at
+//! ([`crate::planner::equilibrium_slopes`]).
 //! The path constraints (obstacles, self-contact, nonlinear fixed conditions) hold at every
 //! interior sample `k_j`: each block's rows are repeated per sample. Energies are dimensionless
 //! (`Rf/L`), positions in units of `L`.
@@ -16,6 +19,7 @@ use crate::constraints::{Adjoint, Constraint, add_penalty_gauss_newton, add_weig
 use crate::kernels::all_zero;
 use crate::optim::{Nlp, Sense};
 use crate::planner::clear_samples::{ClearSamples, LastRows};
+use crate::planner::equilibrium_slopes::Slope;
 use crate::planner::path::DeformationPath;
 use crate::planner::swept::Swept;
 use crate::planner::workers::{JOB_GRADIENT, JOB_HESSIAN, JOB_VALUES, Workers};
@@ -47,6 +51,9 @@ pub struct MinimaxProblem {
     pub track_weight: f64,
     /// Tracking targets: boundary positions (dimensionless) per sample, when set.
     pub targets: Option<Vec<Vec<[f64; 3]>>>,
+    /// The targets' slopes with respect to the end pose, per sample, when known: a sample's
+    /// target then follows its own end pose ([`crate::planner::equilibrium_slopes`]).
+    pub slopes: Option<Vec<Option<Slope>>>,
     /// Swept-clearance rows between consecutive interior samples, when on
     /// ([`MinimaxProblem::set_swept`]).
     swept: Option<Swept>,
@@ -161,6 +168,7 @@ impl MinimaxProblem {
             objective,
             track_weight: 0.0,
             targets: None,
+            slopes: None,
             swept: None,
             skip: None,
             interior,
@@ -343,15 +351,31 @@ impl MinimaxProblem {
         0.5 * self.travel_weight * sum
     }
 
+    /// Sample `j`'s target slope, when set.
+    fn slope(&self, j: usize) -> Option<&Slope> {
+        slope_of(&self.slopes, j)
+    }
+
     /// The tracking term at the last evaluated point.
     pub fn tracking(&self) -> f64 {
         let Some(t) = &self.targets else { return 0.0 };
         let mut sum = 0.0;
-        for (sh, tj) in self.shapes.iter().zip(t) {
+        for (j, (sh, tj)) in self.shapes.iter().zip(t).enumerate() {
             let nb = tj.len() as f64;
-            for (x, xb) in sh.positions.iter().zip(tj) {
-                sum +=
-                    ((x[0] - xb[0]).powi(2) + (x[1] - xb[1]).powi(2) + (x[2] - xb[2]).powi(2)) / nb;
+            match self.slope(j) {
+                Some(sl) => {
+                    for r in sl.residuals(&self.model, &self.a[j], sh, tj) {
+                        sum += (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) / nb;
+                    }
+                }
+                None => {
+                    for (x, xb) in sh.positions.iter().zip(tj) {
+                        sum += ((x[0] - xb[0]).powi(2)
+                            + (x[1] - xb[1]).powi(2)
+                            + (x[2] - xb[2]).powi(2))
+                            / nb;
+                    }
+                }
             }
         }
         0.5 * self.track_weight * sum
@@ -375,18 +399,26 @@ fn travel_cotangent(w: f64, ks: &[f64], shapes: &[Shape], end: usize, j: usize) 
 /// equilibrium's boundary positions, when tracked), and of the travel term to `adj`, with the
 /// weights `(track, travel)`; returns the tracking term's weight per point and its number of
 /// points (for its Gauss–Newton part), `None` without a target.
+#[allow(clippy::too_many_arguments)]
 fn add_track_travel(
     adj: &mut Adjoint,
+    model: &Model,
+    a: &[f64],
     shapes: &[Shape],
     ks: &[f64],
     j: usize,
-    target: Option<&[[f64; 3]]>,
+    target: Option<(&[[f64; 3]], Option<&Slope>)>,
     (track_weight, travel_weight): (f64, f64),
 ) -> Option<(f64, usize)> {
-    let tracked = target.map(|tj| {
+    let tracked = target.map(|(tj, slope)| {
         let wt = track_weight / tj.len() as f64;
-        for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
-            adj.add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+        match slope {
+            Some(sl) => sl.add_cotangents(model, a, &shapes[j], tj, wt, adj),
+            None => {
+                for (b, (x, xb)) in shapes[j].positions.iter().zip(tj).enumerate() {
+                    adj.add_pos(b, wt, [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]]);
+                }
+            }
         }
         (wt, tj.len())
     });
@@ -396,6 +428,14 @@ fn add_track_travel(
         adj.add_pos(end, 1.0, d);
     }
     tracked
+}
+
+/// Sample `j`'s slope in `slopes`, when set.
+fn slope_of(slopes: &Option<Vec<Option<Slope>>>, j: usize) -> Option<&Slope> {
+    slopes
+        .as_ref()
+        .and_then(|s| s.get(j))
+        .and_then(Option::as_ref)
 }
 
 /// The interior samples' shapes in sample order, as the swept rows read them: only they read
@@ -537,7 +577,7 @@ impl Nlp for MinimaxProblem {
         let interior_shapes = swept_shapes(&self.swept, &self.interior, &self.shapes);
         let (model, blocks, offsets) = (&self.model, &self.blocks, &self.offsets);
         let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
-        let (swept, targets) = (&self.swept, &self.targets);
+        let (swept, targets, slopes) = (&self.swept, &self.targets, &self.slopes);
         let tracked = targets.is_some() && self.track_weight > 0.0;
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
@@ -567,9 +607,12 @@ impl Nlp for MinimaxProblem {
                                 blk.add_gradient(model, &a[j], &shapes[j], wb, &mut w.adj);
                             }
                         }
-                        let target = targets.as_ref().filter(|_| tracked).map(|t| &t[j][..]);
+                        let target = targets
+                            .as_ref()
+                            .filter(|_| tracked)
+                            .map(|t| (&t[j][..], slope_of(slopes, j)));
                         let weights = (track_weight, travel_weight);
-                        add_track_travel(&mut w.adj, shapes, ks, j, target, weights);
+                        add_track_travel(&mut w.adj, model, &a[j], shapes, ks, j, target, weights);
                         w.adj.finish(model, &shapes[j], &mut w.ga);
                     }
                     path.project(&w.ga, &mut w.proj);
@@ -605,6 +648,7 @@ impl Nlp for MinimaxProblem {
         let (model, blocks, offsets, path) = (&self.model, &self.blocks, &self.offsets, &self.path);
         let (ks, a, shapes, weights) = (&self.ks, &self.a, &self.shapes, &self.weights);
         let (swept, targets, objective) = (&self.swept, &self.targets, self.objective);
+        let slopes = &self.slopes;
         let (travel_weight, track_weight, mean_weight) =
             (self.travel_weight, self.track_weight, self.mean_weight);
         let r = path.basis.len();
@@ -635,11 +679,19 @@ impl Nlp for MinimaxProblem {
                     if let Some(sw) = swept {
                         sw.add_chord_cotangents(ii, &y[ns..], &interior_shapes, &mut w.adj);
                     }
-                    let target = targets.as_ref().filter(|_| tracked).map(|t| &t[j][..]);
+                    let slope = slope_of(slopes, j);
+                    let target = targets
+                        .as_ref()
+                        .filter(|_| tracked)
+                        .map(|t| (&t[j][..], slope));
                     let weights = (track_weight, travel_weight);
-                    let tracked_at = add_track_travel(&mut w.adj, shapes, ks, j, target, weights);
+                    let tracked_at =
+                        add_track_travel(&mut w.adj, model, aj, shapes, ks, j, target, weights);
                     if let Some((wt, points)) = tracked_at {
                         model.add_positions_gauss_newton(shape, &vec![wt; points], ha);
+                        if let Some(sl) = slope {
+                            sl.add_gauss_newton(model, aj, shape, wt, ha);
+                        }
                     }
                     w.adj.finish_hessian(model, shape, ha);
                     let sj = &s[row..row + per];

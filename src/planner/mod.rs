@@ -10,6 +10,7 @@ pub mod end_course;
 mod end_shapes;
 pub mod endpoints;
 pub mod equilibrium_plan;
+pub mod equilibrium_slopes;
 mod judge;
 pub mod minimax;
 pub mod observer;

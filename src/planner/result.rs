@@ -108,6 +108,10 @@ pub enum Attempt {
     Fallback,
     /// The case's path terms without the travel term (the paper's objective).
     WithoutTravel,
+    /// The case's path terms without the travel term and with tracking's fixed targets
+    /// (`equilibrium_slopes` off: every sample pulled onto the equilibrium of the pose it had
+    /// when the round began): the last attempt, where the slopes' plans all fail.
+    FixedTargets,
     /// A converged plan, collision-free but not executable (the quick attempt's where it
     /// attains the lower bound on `U_max`, or the case's own), lifted to the first fallback count's path
     /// terms (the new terms zero, the same path) and tracked again, with no sharpness stage:
@@ -124,6 +128,7 @@ impl Attempt {
             Attempt::Own => "own",
             Attempt::Fallback => "fallback",
             Attempt::WithoutTravel => "without_travel",
+            Attempt::FixedTargets => "fixed_targets",
             Attempt::Lifted => "lifted",
         }
     }
@@ -506,6 +511,7 @@ mod tests {
             Attempt::Own,
             Attempt::Fallback,
             Attempt::WithoutTravel,
+            Attempt::FixedTargets,
             Attempt::Lifted,
         ] {
             assert_eq!(serde_json::to_value(a).expect("serialises"), a.name());

@@ -52,6 +52,11 @@ pub struct PlanSettings {
     /// progress stop it). Default (absent): 0.5 on a planar rod, 0.1 on a 3D rod (see
     /// [`PlanSettings::tracking_stop`]).
     pub equilibrium_stop: Option<f64>,
+    /// Whether each tracking target follows its sample's own end pose through the slopes of
+    /// its equilibrium (`src/planner/equilibrium_slopes.rs`); `false` pulls every sample onto
+    /// the equilibrium of the pose it had when the round began, as the paper's scheme of
+    /// fixed targets does. Default `true`.
+    pub equilibrium_slopes: bool,
     /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
     pub sharpness: Vec<f64>,
     /// Independent optimiser starts (run in parallel, each verified and refined on its own; the
@@ -195,6 +200,7 @@ impl Default for PlanSettings {
             equilibrium_weight: None,
             equilibrium_rounds: d_rounds(),
             equilibrium_stop: None,
+            equilibrium_slopes: true,
             sharpness: d_sharp(),
             starts: d_starts(),
             parallel_starts: None,

@@ -1,8 +1,10 @@
 //! Which starts run: groups of `parallel_starts` starts side by side; on a planar rod first the
 //! quick attempt ([`Attempt::Quick`]: the first group with the case's path terms, its stages
 //! carrying the optimiser's curvature), then with the case's path terms, then with each of
-//! `fallback_path_terms`, and last (when the objective has a travel term) with the case's path
-//! terms and the paper's objective, without the travel term, until a plan replayed after a
+//! `fallback_path_terms`, then (when the objective has a travel term) with the case's path
+//! terms and the paper's objective, without the travel term, and last (when tracking follows
+//! the slopes of the equilibria) with the paper's objective and tracking's fixed targets
+//! ([`Attempt::FixedTargets`]), until a plan replayed after a
 //! group (the best not replayed yet) is executable (its replay coincides with it, or its
 //! replayed equilibria are a plan; after the quick attempt, only one that attains the lower
 //! bound on `U_max` ends the search); and which of the plans is the plan. Where the quick
@@ -131,6 +133,14 @@ impl Planner {
         p
     }
 
+    /// The planner with the paper's objective and tracking's fixed targets: no travel term, no
+    /// slopes, the same settings otherwise.
+    fn fixed_targets(&self) -> Planner {
+        let mut p = self.without_travel();
+        p.settings.equilibrium_slopes = false;
+        p
+    }
+
     /// The planner of the quick attempt ([`Attempt::Quick`]), the same settings otherwise.
     fn quick(&self) -> Planner {
         let mut p = self.clone();
@@ -201,10 +211,13 @@ impl Planner {
         let starts = self.settings.starts;
         let mut runs: Vec<StartPlan> = Vec::new();
         // On a planar rod the quick attempt, then the case's planner, then one per fallback
-        // count, then (with a travel term) the case's without it, each made only when it is
+        // count, then (with a travel term) the case's without it, then (with the slopes) the
+        // case's without it and with fixed tracking targets, each made only when it is
         // reached. A route that must move the end away and back (two shapes at one pose) is
-        // one the travel term argues against. Each attempt but the case's own has an
-        // evaluation budget. (On a 3D rod the case's own stages already carry the curvature.)
+        // one the travel term argues against; one through a fork of the equilibria (a strip
+        // that may buckle either way) is one the slopes' targets can lead the wrong way. Each
+        // attempt but the case's own has an evaluation budget. (On a 3D rod the case's own
+        // stages already carry the curvature.)
         let spatial = self.base.model.layout.spatial;
         let fallbacks = self.settings.fallback_terms(spatial);
         let budget = |p: Planner| Cow::Owned(self.budgeted(p));
@@ -220,6 +233,10 @@ impl Planner {
             .chain(
                 (self.settings.travel_weight > 0.0)
                     .then(|| (Attempt::WithoutTravel, budget(self.without_travel()))),
+            )
+            .chain(
+                (self.settings.equilibrium_slopes && self.settings.tracking_weight(spatial) > 0.0)
+                    .then(|| (Attempt::FixedTargets, budget(self.fixed_targets()))),
             );
         // Unless the case says otherwise, once an attempt's plans all tunnel through an obstacle
         // between their samples (the verification grid finds them colliding), the attempts

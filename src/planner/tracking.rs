@@ -1,8 +1,11 @@
 //! Equilibrium tracking: after the sharpness stages, the planner replays its own samples (the
 //! equilibria their end poses produce) and pulls each sampled shape onto that equilibrium by a
 //! term in the objective, re-optimising, round after round while it helps (docs/algorithms.md,
-//! step 4).
+//! step 4). Each target follows its sample's end pose through the equilibrium's slopes
+//! (`equilibrium_slopes.rs`), unless `equilibrium_slopes` is off.
 
+use super::endpoints::EndPose;
+use super::equilibrium_slopes::Slope;
 use super::minimax::MinimaxProblem;
 use super::start::Tally;
 use super::{Planner, replay};
@@ -69,8 +72,8 @@ impl Planner {
         // started from the round before's equilibrium at its first `k` (the path has moved a
         // little), shared out over the optimiser's threads.
         let mut solved: Option<Vec<crate::statics::StaticSolution>> = None;
-        let mut equilibria = |p: &MinimaxProblem, z: &[f64]| {
-            let found = match &solved {
+        let equilibria = |p: &MinimaxProblem, z: &[f64], solved: &mut Option<Vec<_>>| {
+            let found = match solved {
                 None => replay::equilibria(
                     &inflated,
                     &self.start,
@@ -90,15 +93,15 @@ impl Planner {
                     p.workers(),
                 ),
             };
-            let (positions, sols) = found.into_iter().unzip();
-            solved = Some(sols);
+            let (positions, sols): (Vec<_>, Vec<_>) = found.into_iter().unzip();
+            *solved = Some(sols);
             positions
         };
         for _ in 0..self.settings.equilibrium_rounds {
             if self.stopped() || self.over_budget(tally.evaluations) || self.time_up() {
                 break;
             }
-            let targets: Vec<Vec<[f64; 3]>> = equilibria(p, z);
+            let targets = equilibria(p, z, &mut solved);
             let moved = p.targets.as_ref().map_or(f64::INFINITY, |old| {
                 old.iter()
                     .zip(&targets)
@@ -127,6 +130,10 @@ impl Planner {
                 break;
             }
             p.targets = Some(targets);
+            p.slopes = solved
+                .as_deref()
+                .filter(|_| self.settings.equilibrium_slopes)
+                .map(|sols| slopes_of(&inflated, p, z, sols));
             // Targets that no longer move: the path already sits on its equilibria.
             if moved < 1e-4 || dev <= done || dev > (1.0 - TRACK_PROGRESS) * dev_prev {
                 estimate = Some(dev);
@@ -154,9 +161,33 @@ impl Planner {
         // The rounds' budget spent (or none allowed): measure the kept path's samples once
         // more, so that the estimate is there for choosing among starts.
         if estimate.is_none() && !failed {
-            let targets = equilibria(p, z);
+            let targets = equilibria(p, z, &mut solved);
             estimate = Some(p.distance_to(z, &targets));
         }
         (tracking_rounds, kept, estimate)
     }
+}
+
+/// The slopes of the equilibria `sols` of the samples of `p`'s path `z` (solved under `base`)
+/// with respect to their end poses; `None` for an equilibrium that did not converge.
+fn slopes_of(
+    base: &crate::statics::problem::StaticProblem,
+    p: &MinimaxProblem,
+    z: &[f64],
+    sols: &[crate::statics::StaticSolution],
+) -> Vec<Option<Slope>> {
+    let model = &base.model;
+    let mut a = vec![0.0; p.path.n()];
+    p.ks.iter()
+        .zip(sols)
+        .map(|(&k, sol)| {
+            if sol.status != crate::statics::SolveStatus::Converged {
+                return None;
+            }
+            p.path.shape_at(z, k, &mut a);
+            let shape = model.evaluate(&a);
+            let pose = EndPose::of(model, &a, &shape.positions);
+            Slope::of(base, &pose, sol)
+        })
+        .collect()
 }

@@ -28,5 +28,6 @@ mod suite;
 mod suite_sample;
 mod threads;
 mod time_limit;
+mod tracking_slopes;
 mod turned_scenes;
 mod wide_kernels;

@@ -58,8 +58,9 @@ fn after_quick(
 }
 
 /// The attempts after the case's own have an evaluation budget (so has the quick attempt before
-/// it): on the paper's case with its three path terms (whose first start does not coincide),
-/// no equilibrium plans and no lift of the own plan (which would run before the fallback), the
+/// it): on the paper's case with its three path terms and fixed tracking targets
+/// (`"equilibrium_slopes": false`, under which its first start does not coincide), no
+/// equilibrium plans and no lift of the own plan (which would run before the fallback), the
 /// six-term fallback stops its sharpness stages once it has used `fallback_evaluations` (checked
 /// between stages, so it may exceed it by one stage: with a budget of 100 it runs its first
 /// stage only), says `iteration_limit`, and its plan is still verified and reported; without
@@ -80,7 +81,8 @@ fn fallback_attempts_stop_at_their_evaluation_budget() {
         let c = shipped_variant("plan_paper_planar.json", |v| {
             let fields = serde_json::json!({
                 "path_terms": 3, "safety_margin": 0.01, "starts": 1, "fallback_path_terms": [6],
-                "equilibrium_plans": false, "fallback_evaluations": budget, "lift": false
+                "equilibrium_plans": false, "fallback_evaluations": budget, "lift": false,
+                "equilibrium_slopes": false
             });
             for (key, val) in fields.as_object().unwrap() {
                 v["plan"][key] = val.clone();
@@ -133,8 +135,8 @@ fn fallback_attempts_stop_at_their_evaluation_budget() {
 /// alone pulls it onto the equilibria. With the default tracking (weight 10,000, up to eight
 /// rounds, stopped at the shipped 80 % of the tolerance) the replay coincides (measured 1.53 %
 /// of L after four rounds; 1.29 % after six with the default stop at a tenth); with the earlier weight 1000 and three
-/// rounds it departs by more than the 2 % tolerance (measured 2.82 %), from the same sharpness
-/// stages.
+/// rounds, and fixed targets (`"equilibrium_slopes": false`), it departs by more than the 2 %
+/// tolerance (measured 2.82 %), from the same sharpness stages.
 #[test]
 fn stronger_tracking_makes_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
@@ -150,7 +152,9 @@ fn stronger_tracking_makes_a_moved_pose_coincide() {
         Planner::from_case(&c).unwrap().run(&mut Silent)
     };
     let strong = run(serde_json::json!({}));
-    let weak = run(serde_json::json!({ "equilibrium_weight": 1000.0, "equilibrium_rounds": 3 }));
+    let weak = run(serde_json::json!({
+        "equilibrium_weight": 1000.0, "equilibrium_rounds": 3, "equilibrium_slopes": false
+    }));
     for r in [&strong, &weak] {
         assert_eq!(r.status, PlanStatus::Planned);
         assert!(r.replay.all_converged && r.replay.all_stable);
@@ -337,6 +341,9 @@ fn replay_reports_where_it_leans_on_obstacles() {
         // report's replay its own (not replayed equilibria held off the block).
         v["plan"]["fallback_path_terms"] = serde_json::json!([]);
         v["plan"]["equilibrium_plans"] = serde_json::json!(false);
+        // The fixed tracking targets the scenario was built with (with the slopes the
+        // replay keeps off the block).
+        v["plan"]["equilibrium_slopes"] = serde_json::json!(false);
         // Forces in units of Rf/L² = 3, so that a force missing its unit shows.
         v["rod"]["flexural_rigidity"] = serde_json::json!(3.0);
     });
@@ -362,9 +369,11 @@ fn replay_reports_where_it_leans_on_obstacles() {
             assert_eq!(st.contact_force, 0.0, "k = {}", st.k);
         }
     }
+    // The smallest clearance is that of the equilibria: over the steps whose solves converged.
     let smallest = rp
         .steps
         .iter()
+        .filter(|s| s.converged)
         .filter_map(|s| s.clearance)
         .fold(f64::INFINITY, f64::min);
     assert_eq!(rp.min_clearance, Some(smallest));
@@ -441,9 +450,10 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
         r.replay.max_deviation_over_l
     );
 
-    // Seed 14: the first start's plan departs from its replay, whose equilibria are a plan;
-    // the second start does not run.
-    let eq = paper_with(serde_json::json!({ "seed": 14 }));
+    // Seed 14 with fixed tracking targets (`"equilibrium_slopes": false`; with the slopes
+    // the first start's plan coincides): the first start's plan departs from its replay,
+    // whose equilibria are a plan; the second start does not run.
+    let eq = paper_with(serde_json::json!({ "seed": 14, "equilibrium_slopes": false }));
     assert_eq!((after_quick(&eq).0.len(), eq.starts_not_run), (1, 1));
     assert!(!eq.replay.coincide);
     assert_eq!(eq.executed_path(), Some("equilibria"));
@@ -451,7 +461,9 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     // which peaks inside the path below the own plan (5.28 against 5.39 measured) and so was
     // neither tracked nor replayed, is then lifted to six path terms and tracked: it
     // coincides with its replay at a lower U_max, and is the plan.
-    let lq = paper_with(serde_json::json!({ "seed": 14, "fallback_path_terms": [6, 8] }));
+    let lq = paper_with(serde_json::json!({
+        "seed": 14, "fallback_path_terms": [6, 8], "equilibrium_slopes": false
+    }));
     let kinds: Vec<Attempt> = lq.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
     assert_eq!(lq.chosen_start, Some(lq.starts[2].start));
@@ -459,7 +471,9 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     assert_eq!(lq.executed_path(), Some("optimal"));
     assert!(lq.u_max < eq.u_max, "{} vs {}", lq.u_max, eq.u_max);
     // Only the optimal path as planned counts (`"equilibrium_plans": false`): the second runs.
-    let r5 = paper_with(serde_json::json!({ "seed": 14, "equilibrium_plans": false }));
+    let r5 = paper_with(serde_json::json!({
+        "seed": 14, "equilibrium_plans": false, "equilibrium_slopes": false
+    }));
     let (own5, chosen5) = after_quick(&r5);
     assert_eq!((own5.len(), r5.starts_not_run, chosen5), (2, 0, Some(1)));
     assert_eq!(r5.executed_path(), Some("optimal"));
@@ -468,7 +482,8 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
     assert!(own5[1].equilibrium_deviation.expect("measured") <= 0.02);
     assert!(r5.replay.coincide);
     let six = paper_with(serde_json::json!({
-        "seed": 15, "starts": 1, "parallel_starts": 1, "equilibrium_plans": false
+        "seed": 15, "starts": 1, "parallel_starts": 1, "equilibrium_plans": false,
+        "equilibrium_slopes": false
     }));
     assert_eq!(six.path, r5.path);
     assert_eq!(six.u_max.to_bits(), r5.u_max.to_bits());
@@ -477,8 +492,9 @@ fn paper_second_start_runs_only_when_the_first_does_not_coincide() {
 /// The shipped case stops equilibrium tracking once the samples lie within 80 % of the
 /// tolerance from their equilibria (`"equilibrium_stop": 0.8`): its first start's samples do
 /// after the sharpness stages (measured 1.46 % of L), so it runs no round. With a stop at a
-/// tenth of the tolerance (the 3D default) it runs one, which leaves the samples farther from
-/// their equilibria and is undone: the plan is the same bit for bit, at the cost of that round.
+/// tenth of the tolerance (the 3D default) rounds run, and the plan keeps them: following the
+/// slopes of the equilibria, they bring the samples closer (measured two rounds, 0.77 % of
+/// L), and the replay coincides more closely, at a peak 0.4 % higher (5.260 against 5.238).
 #[test]
 fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
     let (p, r) = paper();
@@ -489,12 +505,14 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
     assert!(est <= 0.8 * p.settings.coincide_tolerance, "{est}");
     let tenth = paper_with(serde_json::json!({ "equilibrium_stop": 0.1 }));
     let t = after_quick(&tenth).0[0];
-    assert_eq!((t.tracking_rounds, t.tracking_rounds_kept), (1, 0));
-    assert_eq!(tenth.z, r.z);
-    assert_eq!(tenth.u_max.to_bits(), r.u_max.to_bits());
-    assert_eq!(
-        tenth.replay.max_deviation_over_l.to_bits(),
-        r.replay.max_deviation_over_l.to_bits()
+    assert!(t.tracking_rounds_kept > 0, "{t:?}");
+    let closer = t.equilibrium_deviation.expect("measured");
+    assert!(closer < est, "{closer} against {est}");
+    assert!(
+        tenth.replay.coincide && tenth.replay.max_deviation_over_l < r.replay.max_deviation_over_l,
+        "{} against {}",
+        tenth.replay.max_deviation_over_l,
+        r.replay.max_deviation_over_l
     );
 }
 
@@ -509,11 +527,14 @@ fn paper_tracking_stops_once_the_samples_are_within_the_stop() {
 /// runs. The scenario is the case's own attempt's, so the lift of the quick plan, which
 /// attains the lower bound and departs by 5.1 %, is left out, `"lift": false`; with it, the
 /// lift runs once, with six terms, right after the quick attempt, and every start keeps its
-/// own index, in the order the starts ran.)
+/// own index, in the order the starts ran.) The scenario keeps the fixed tracking targets it
+/// was built with (`"equilibrium_slopes": false`); with the slopes the first start's four-term
+/// plan coincides.
 #[test]
 fn fallback_path_terms_make_a_moved_pose_coincide() {
     let run = |extra: serde_json::Value| {
         let c = shipped_variant("plan_paper_planar.json", |v| {
+            v["plan"]["equilibrium_slopes"] = serde_json::json!(false);
             v["plan"]["start"] = serde_json::json!({ "x": 0.358, "z": 0.745, "theta": 0.33 });
             v["plan"]["goal"] = serde_json::json!({ "x": -0.484, "z": 0.601, "theta": -0.323 });
             for (key, val) in extra.as_object().unwrap() {
@@ -577,10 +598,14 @@ fn fallback_path_terms_make_a_moved_pose_coincide() {
 /// the better of them: with seeds 16–17, start 16's refined plan peaks at 5.39 and is estimated
 /// to depart from its replay (2.48 % of L), while start 17's refined plan peaks at 5.24 and
 /// coincides. The pair keeps start 17's (when only an optimal path that coincides counts:
-/// by default start 16's replayed equilibria are a plan, and start 17 does not run).
+/// by default start 16's replayed equilibria are a plan, and start 17 does not run), with
+/// fixed tracking targets (`"equilibrium_slopes": false`; with the slopes start 16's plan
+/// coincides).
 #[test]
 fn paper_two_starts_keep_the_better_verified_plan() {
-    let r = paper_with(serde_json::json!({ "seed": 16, "equilibrium_plans": false }));
+    let r = paper_with(serde_json::json!({
+        "seed": 16, "equilibrium_plans": false, "equilibrium_slopes": false
+    }));
     assert_eq!(r.status, PlanStatus::Planned);
     let (own, chosen) = after_quick(&r);
     assert_eq!(own.len(), 2);
@@ -784,8 +809,10 @@ fn a_goal_at_the_start_pose_is_planned_without_moving() {
 /// Start and goal share the end pose but are the two mirror-image S-shapes `θ(s)` and
 /// `θ(L − s)`, both stable. With the paper's objective alone (no tracking, no travel term) the
 /// planner's path turns one into the other through shapes no end pose produces, and the verdict
-/// says the end cannot execute it. With tracking (the default; its travel term is dropped in
-/// the last fallback) it finds the route a person would take — pull the end out until the
+/// says the end cannot execute it. With tracking (the default; its travel term and its slopes
+/// are dropped in the last fallback: the plans with them pass the fork where the straight strip
+/// buckles either way, and their replays end in the other S) it finds the route a person would
+/// take — pull the end out until the
 /// strip is nearly straight, then push it back into the other S — and the replay follows.
 #[test]
 fn twin_shapes_need_the_end_pulled_straight() {
@@ -843,7 +870,8 @@ fn twin_shapes_need_the_end_pulled_straight() {
         .fold(0.0, f64::max);
     assert!(swing > untracked.replay.tolerance, "{swing}");
     // By default the travel term argues against pulling the end out: no plan with it is
-    // executable, and the last fallback, the paper's objective with tracking, is the plan.
+    // executable, and the last fallback, the paper's objective with tracking's fixed targets,
+    // is the plan.
     let tracked = run("");
     assert_eq!(
         tracked.starts[tracked.chosen_start.unwrap()].travel_weight,
@@ -890,8 +918,9 @@ impl dlo_planner::planner::observer::PlanObserver for Feasible {
 /// negative. Each snap is a real one: between two replayed equilibria (both converged and
 /// stable) at most 1/640 apart in k the shape jumps by more than 0.02 L and the energy drops —
 /// the strip releases energy — while the plan's own energy hardly changes. The scenario keeps
-/// the objective and equilibrium tracking it was built with (no travel term, weight 1000, and the
-/// one round the planner ran on it then). With the default's stronger tracking the plan differs: its second snap, at
+/// the objective and equilibrium tracking it was built with (no travel term, weight 1000, the
+/// one round the planner ran on it then, and fixed targets: `"equilibrium_slopes": false`;
+/// with the default tracking, slopes and all, the plan is executable without a snap). With the default's stronger tracking the plan differs: its second snap, at
 /// k = 0.575, is as real (a jump of 0.044 L within 1/640 in k, both sides stable) but releases
 /// only 4 % (0.0496 → 0.0476) while the plan's own energy changes as much there; with no
 /// tracking, or with a round undone, the plan's energy changes by 2.0 % at the first snap.
@@ -911,7 +940,7 @@ fn replay_reports_snap_through() {
     )
     .replace(
         r#""k_samples": 21"#,
-        r#""k_samples": 21, "equilibrium_weight": 1000.0, "equilibrium_rounds": 1, "fallback_path_terms": [], "travel_weight": 0"#,
+        r#""k_samples": 21, "equilibrium_weight": 1000.0, "equilibrium_rounds": 1, "equilibrium_slopes": false, "fallback_path_terms": [], "travel_weight": 0"#,
     );
     let c = case::parse(&text, Path::new("snap.json")).unwrap();
     let p = Planner::from_case(&c).unwrap();
@@ -1405,12 +1434,16 @@ fn pillar_case_3d_coincides() {
 /// finds, and the refined plan clears the pillar (measured +1.45e-5 after five added samples,
 /// four of them between the verification's grid values) and coincides with its replay. (When
 /// the verification looked only at its 201 grid values, each round moved the crossing into
-/// another gap and the plan ended in a collision.)
+/// another gap and the plan ended in a collision.) The scenario keeps the fixed tracking
+/// targets it was built with (`"equilibrium_slopes": false`): with the slopes the optimiser
+/// takes another route, whose crossing sample refinement does not clear, and the verdict is
+/// `collision` (with the swept rows, on by default, the shipped case coincides either way).
 #[test]
 fn pillar_case_tunnels_without_swept_clearance() {
     let c = shipped_variant("plan_cable_around_pillar.json", |v| {
         v["plan"]["swept_clearance"] = serde_json::json!(false);
         v["plan"]["travel_weight"] = serde_json::json!(0);
+        v["plan"]["equilibrium_slopes"] = serde_json::json!(false);
     });
     let r = Planner::from_case(&c).unwrap().run(&mut Silent);
     assert_eq!(r.status, PlanStatus::Planned);

@@ -49,7 +49,8 @@ fn check_with(name: &str, tracking: bool, swept: bool) {
     check_gradient(&format!("{name} (tracking {tracking})"), p, &z);
 }
 
-fn check_gradient(name: &str, mut p: MinimaxProblem, z: &[f64]) {
+/// The gradient of `f + Σ yᵢcᵢ` against central differences (relative 1e-6).
+pub(crate) fn check_gradient(name: &str, mut p: MinimaxProblem, z: &[f64]) {
     let z = z.to_vec();
     let (n, m) = (p.n(), p.m());
     let y: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 0.37).cos()).collect();
