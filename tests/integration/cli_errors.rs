@@ -677,8 +677,7 @@ fn plan_prints_documented_json_and_exit_codes() {
     }
     log_ok("tunnels");
 
-    // A buckled arch planned to a turned end, with tracking's fixed targets: the replay snaps
-    // through (tests/integration/planner.rs; with the slopes the plan is executable).
+    // A buckled arch planned to a turned end: the replay snaps through (tests/integration/planner.rs).
     let snap = dir.join("snap.json");
     std::fs::write(
         &snap,
@@ -688,7 +687,7 @@ fn plan_prints_documented_json_and_exit_codes() {
   "plan": {
     "start": { "x": 0.0, "z": 0.8, "theta": 0.0, "shape": { "theta": [0, 0, 1.2, 0, 0, 0, 0, 0, 0, 0] } },
     "goal": { "x": 0.0, "z": 0.8, "theta": 0.8, "shape": { "theta": [0, 0, -1.2, 0, 0, 0, 0, 0, 0, 0] } },
-    "k_samples": 21, "fallback_path_terms": [], "equilibrium_slopes": false } }"#,
+    "k_samples": 21, "fallback_path_terms": [] } }"#,
     )
     .unwrap();
     let (code, out, err) = plan_json(snap.to_str().unwrap());

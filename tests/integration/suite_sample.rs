@@ -511,9 +511,9 @@ fn equilibria_that_dip_and_end_elsewhere_are_replayed_on_chords() {
 /// between the case's 32 contact samples, so the plan is made with 64, its end solves started
 /// from the shapes solved with 32. With fixed tracking targets ([`fixed_targets`]) the plan is
 /// executable, ends on the goal shape and keeps clear of the obstacles on a grid four times
-/// finer in s. (With the defaults the search ends with no executable plan: the case's own plan
-/// tunnels, and the fallbacks' replays end 0.42 L from the goal shape, on another equilibrium
-/// of the goal pose.)
+/// finer in s. (With the defaults the case's own plan tunnels and the fallbacks' replays end
+/// on another equilibrium of the goal pose; the plan is the attempt without the travel term's,
+/// executed by its replayed equilibria at U_max 10.61, against 9.33 with fixed targets.)
 #[test]
 fn an_end_that_dips_between_contact_samples_is_planned_with_more() {
     let (p, r) = suite_planar_plan_with(53, 10, fixed_targets(serde_json::json!({})));

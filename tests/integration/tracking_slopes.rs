@@ -83,21 +83,30 @@ fn slope_error(pl: &Planner, pose: &EndPose, sol: &StaticSolution) -> f64 {
     worst
 }
 
+/// [`slope_error`] within 1e-4 at the straight path's equilibrium at `k` of each case, each
+/// resting on an obstacle or free of contact as `in_contact` says.
+fn slopes_match(cases: &[(&str, f64)], in_contact: bool) {
+    for &(name, k) in cases {
+        let pl = shipped(name);
+        let (pose, sol) = equilibrium_at(&pl, k);
+        assert_eq!(contacts(&pl, &sol) > 0, in_contact, "{name} at {k}");
+        let err = slope_error(&pl, &pose, &sol);
+        assert!(err < 1e-4, "{name}: relative error {err:e}");
+    }
+}
+
 /// Free of contact: the paper's planar case (end position and angle) a fifth of the way
 /// along its straight path, and the pillar case's 3D cable (position and three angles) a
 /// quarter of the way.
 #[test]
 fn equilibrium_slopes_match_differences_of_equilibria() {
-    for (name, k) in [
-        ("plan_paper_planar.json", 0.2),
-        ("plan_cable_around_pillar.json", 0.25),
-    ] {
-        let pl = shipped(name);
-        let (pose, sol) = equilibrium_at(&pl, k);
-        assert_eq!(contacts(&pl, &sol), 0, "{name}");
-        let err = slope_error(&pl, &pose, &sol);
-        assert!(err < 1e-4, "{name}: relative error {err:e}");
-    }
+    slopes_match(
+        &[
+            ("plan_paper_planar.json", 0.2),
+            ("plan_cable_around_pillar.json", 0.25),
+        ],
+        false,
+    );
 }
 
 /// Resting on an obstacle (the paper's planar case a quarter of the way, the pillar case's
@@ -105,16 +114,13 @@ fn equilibrium_slopes_match_differences_of_equilibria() {
 /// obstacle's surface.
 #[test]
 fn equilibrium_slopes_hold_the_contacts_they_rest_on() {
-    for (name, k) in [
-        ("plan_paper_planar.json", 0.25),
-        ("plan_cable_around_pillar.json", 0.385),
-    ] {
-        let pl = shipped(name);
-        let (pose, sol) = equilibrium_at(&pl, k);
-        assert!(contacts(&pl, &sol) > 0, "{name}: no contact");
-        let err = slope_error(&pl, &pose, &sol);
-        assert!(err < 1e-4, "{name}: relative error {err:e}");
-    }
+    slopes_match(
+        &[
+            ("plan_paper_planar.json", 0.25),
+            ("plan_cable_around_pillar.json", 0.385),
+        ],
+        true,
+    );
 }
 
 /// The planning objective with tracking targets that follow the samples' end poses: targets
