@@ -54,8 +54,8 @@ pub struct PlanSettings {
     pub equilibrium_stop: Option<f64>,
     /// Whether each tracking target follows its sample's own end pose through the slopes of
     /// its equilibrium (`src/planner/equilibrium_slopes.rs`); `false` pulls every sample onto
-    /// the equilibrium of the pose it had when the round began, as the paper's scheme of
-    /// fixed targets does. Default `true`.
+    /// the equilibrium of the pose it had when the round began (fixed targets). Default
+    /// `true`.
     pub equilibrium_slopes: bool,
     /// Continuation of the smoothed maximum's sharpness, in units of `1/U_ref`.
     pub sharpness: Vec<f64>,

@@ -99,11 +99,10 @@ fn suite_planar_plan_of(
     suite_planar_plan_with(seed, i, serde_json::json!({}))
 }
 
-/// The `plan` settings of a scenario built with fixed tracking targets: every sample pulled
-/// onto the equilibrium of the pose it had when the round began, as before tracking followed
-/// the slopes of the equilibria (`equilibrium_slopes`). The scenarios that need an optimal path
-/// whose replay departs take them; with the slopes the same problems' optimal paths mostly
-/// coincide.
+/// `fields` with fixed tracking targets (`"equilibrium_slopes": false`): every sample pulled
+/// onto the equilibrium of the pose it had when the round began, not moved along the slopes
+/// of the equilibria. The scenarios that need an optimal path whose replay departs take them;
+/// with the slopes the same problems' optimal paths mostly coincide.
 fn fixed_targets(mut fields: serde_json::Value) -> serde_json::Value {
     fields["equilibrium_slopes"] = false.into();
     fields
