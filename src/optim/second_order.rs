@@ -16,6 +16,25 @@ pub fn lagrangian_hessian_and_tangents<P: Nlp>(
     lambda: &[f64],
     lambda_tol: f64,
 ) -> (DMatrix<f64>, bool, DMatrix<f64>) {
+    let (hess, exact, active) = lagrangian_hessian_and_active_rows(p, x, lambda, lambda_tol);
+    let z = match active {
+        None => DMatrix::identity(p.n(), p.n()),
+        Some((_, j)) => null_space(&j),
+    };
+    (hess, exact, z)
+}
+
+/// [`lagrangian_hessian_and_tangents`] with the active rows themselves instead of their null
+/// space: the Hessian, whether it is analytic, and (unless no row is active) the indices of the
+/// equality rows and of the inequality rows with `λ > lambda_tol`, in order, with their
+/// Jacobian (one row each).
+#[allow(clippy::type_complexity)]
+pub fn lagrangian_hessian_and_active_rows<P: Nlp>(
+    p: &mut P,
+    x: &[f64],
+    lambda: &[f64],
+    lambda_tol: f64,
+) -> (DMatrix<f64>, bool, Option<(Vec<usize>, DMatrix<f64>)>) {
     let (n, m) = (p.n(), p.m());
     let mut c = vec![0.0; m];
     let mut hess = DMatrix::<f64>::zeros(n, n);
@@ -48,14 +67,12 @@ pub fn lagrangian_hessian_and_tangents<P: Nlp>(
     let rows: Vec<usize> = (0..m)
         .filter(|&i| p.sense(i) == Sense::Equal || lambda[i] > lambda_tol)
         .collect();
-    let z = if rows.is_empty() {
-        DMatrix::identity(n, n)
-    } else {
+    let active = (!rows.is_empty()).then(|| {
         let (_, jr) = jacobian_rows_at(p, x, &rows);
         let j = DMatrix::from_fn(rows.len(), n, |r, k| jr[r][k]);
-        null_space(&j)
-    };
-    (hess, exact, z)
+        (rows, j)
+    });
+    (hess, exact, active)
 }
 
 /// Eigenvalues of the reduced Hessian `Zᵀ ∇²ℒ Z` (ascending), where `Z` spans the null space of

@@ -15,14 +15,13 @@
 
 use super::endpoints::EndPose;
 use crate::constraints::{Adjoint, Constraint};
-use crate::optim::augmented_lagrangian::jacobian_rows_at;
-use crate::optim::second_order::lagrangian_hessian_and_tangents;
-use crate::optim::{Nlp, Sense};
+use crate::optim::Nlp;
+use crate::optim::second_order::{lagrangian_hessian_and_active_rows, null_space};
 use crate::rod::kinematics::Shape;
 use crate::rod::model::Model;
 use crate::statics::StaticSolution;
 use crate::statics::problem::StaticProblem;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Inequality rows whose multiplier exceeds this are held active.
 const ACTIVE: f64 = 1e-8;
@@ -55,20 +54,16 @@ impl Slope {
     /// than 10 L per unit of the pose, or where the solve left no multipliers.
     pub fn of(base: &StaticProblem, pose: &EndPose, sol: &StaticSolution) -> Option<Slope> {
         let mut p = pose.problem(base);
-        let (n, m) = (Nlp::n(&p), Nlp::m(&p));
+        let m = Nlp::m(&p);
         let m0 = Nlp::m(base);
         if sol.lambda.len() != m || m == m0 {
             return None;
         }
         let (a, lambda) = (&sol.a[..], &sol.lambda[..]);
-        let (hess, _, z) = lagrangian_hessian_and_tangents(&mut p, a, lambda, ACTIVE);
-        let rows: Vec<usize> = (0..m)
-            .filter(|&i| p.sense(i) == Sense::Equal || lambda[i] > ACTIVE)
-            .collect();
-        let mut c = vec![0.0; m];
-        p.values(a, &mut c);
-        let (_, jr) = jacobian_rows_at(&mut p, a, &rows);
-        let j = DMatrix::from_fn(rows.len(), n, |r, k| jr[r][k]);
+        // The pose rows are equalities, so some row is always active.
+        let (hess, _, active) = lagrangian_hessian_and_active_rows(&mut p, a, lambda, ACTIVE);
+        let (rows, j) = active?;
+        let z = null_space(&j);
         let svd = j.svd(true, true);
         let smax = svd.singular_values.max();
         let pinv = svd.pseudo_inverse(RANK * smax.max(1e-300)).ok()?;

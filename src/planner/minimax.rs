@@ -351,18 +351,13 @@ impl MinimaxProblem {
         0.5 * self.travel_weight * sum
     }
 
-    /// Sample `j`'s target slope, when set.
-    fn slope(&self, j: usize) -> Option<&Slope> {
-        slope_of(&self.slopes, j)
-    }
-
     /// The tracking term at the last evaluated point.
     pub fn tracking(&self) -> f64 {
         let Some(t) = &self.targets else { return 0.0 };
         let mut sum = 0.0;
         for (j, (sh, tj)) in self.shapes.iter().zip(t).enumerate() {
             let nb = tj.len() as f64;
-            match self.slope(j) {
+            match slope_of(&self.slopes, j) {
                 Some(sl) => {
                     for r in sl.residuals(&self.model, &self.a[j], sh, tj) {
                         sum += (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) / nb;
