@@ -158,10 +158,18 @@ struct State {
 }
 
 /// Multipliers that warm-start the solve of `p` (the base problem plus an end pose) from `from`:
-/// all of `from`'s when its rows are `p`'s, else its base rows' (the case's conditions,
-/// obstacles and self-contact come first in both) and zero for the pose rows, so that contact
-/// forces carry over even where the end pose has other rows.
-fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProblem) -> Vec<f64> {
+/// all of `from`'s when its rows are `p`'s; else (`from` is an end shape solved for its own
+/// pose rows, such as a position alone, or another spelling of the angles) its base rows' (the
+/// case's conditions, obstacles and self-contact come first in both), so that contact forces
+/// carry over, and for the pose rows the reactions that balance `from`'s shape with them
+/// ([`pose_multipliers`]). A shape solved for a position alone is an equilibrium of the same
+/// pose with its end's angles held too, whose moment there is zero: with the end's force set
+/// to zero instead, the first Newton steps leave that equilibrium and can settle on another.
+fn warm_multipliers(
+    base: &StaticProblem,
+    from: &StaticSolution,
+    p: &mut StaticProblem,
+) -> Vec<f64> {
     let m = crate::optim::Nlp::m(p);
     if from.lambda.len() == m {
         return from.lambda.clone();
@@ -169,7 +177,41 @@ fn warm_multipliers(base: &StaticProblem, from: &StaticSolution, p: &StaticProbl
     let nb = crate::optim::Nlp::m(base).min(from.lambda.len());
     let mut l = vec![0.0; m];
     l[..nb].copy_from_slice(&from.lambda[..nb]);
+    if !from.lambda.is_empty() {
+        pose_multipliers(p, &from.a, crate::optim::Nlp::m(base), &mut l);
+    }
     l
+}
+
+/// Sets the multipliers of `p`'s rows from `first` on (its end pose's equalities) to the
+/// least-squares solution of `∇V + Jᵀλ = 0` at the shape `a`, the other rows' multipliers
+/// held as `lambda` gives them: the end's reactions that balance the shape. Leaves `lambda` as
+/// it is where the rows are not independent there.
+fn pose_multipliers(p: &mut StaticProblem, a: &[f64], first: usize, lambda: &mut [f64]) {
+    use crate::optim::Nlp;
+    use nalgebra::{DMatrix, DVector};
+    let m = p.m();
+    if first >= m {
+        return;
+    }
+    let rows: Vec<usize> = (first..m).collect();
+    let (_, jac) = crate::optim::augmented_lagrangian::jacobian_rows(p, a, &rows);
+    let mut held = lambda.to_vec();
+    held[first..].iter_mut().for_each(|v| *v = 0.0);
+    let mut g = vec![0.0; p.n()];
+    p.gradient(a, &held, &mut g);
+    let jt = DMatrix::from_fn(g.len(), rows.len(), |i, j| jac[j][i]);
+    let svd = jt.svd(true, true);
+    let smax = svd.singular_values.max();
+    // Rows that are not independent at `a` (or a shape with non-finite values): left as given.
+    if smax.is_nan() || smax <= 0.0 || svd.singular_values.min() < 1e-9 * smax {
+        return;
+    }
+    if let Ok(sol) = svd.solve(&-DVector::from_column_slice(&g), 0.0)
+        && sol.iter().all(|v| v.is_finite())
+    {
+        lambda[first..].copy_from_slice(sol.as_slice());
+    }
 }
 
 /// The static shape of `base` held at end pose `pose`, solved from `from`'s shape and
@@ -185,7 +227,7 @@ pub(super) fn solve_held(
     stiff_retry: bool,
 ) -> (StaticProblem, StaticSolution) {
     let mut p = pose.problem(base);
-    let lambda = warm_multipliers(base, from, &p);
+    let lambda = warm_multipliers(base, from, &mut p);
     let sol = solve_static_warm(&mut p, &from.a, &lambda, opts);
     if sol.status == SolveStatus::Converged || !stiff_retry {
         return (p, sol);
@@ -560,4 +602,58 @@ fn march(
         out.push((model.evaluate(&sol.a).positions, sol));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optim::augmented_lagrangian::kkt_residual;
+    use crate::rod::{Rod, layout::Layout};
+    use crate::statics::solve_static;
+
+    /// A planar rod clamped along +z with its end held at (0.4, 0, 0.7) L by its position
+    /// alone, free to turn: with its angle held too (the replay's and tracking's end pose), the
+    /// solved shape balances with the multipliers that warm-start its solve — its own end force
+    /// and a zero moment — to the solver's tolerance, where the end's rows set to zero leave it
+    /// out of balance by that force.
+    #[test]
+    fn an_end_solved_for_its_position_alone_warm_starts_with_its_own_reactions() {
+        let rod = Rod::uniform(1.0, 1.0);
+        let base = StaticProblem::builder(rod.clone(), Layout::of(&rod, 4))
+            .clamp(0.0, [0.0; 3], &[0.0])
+            .build()
+            .expect("a clamped rod");
+        let model = &base.model;
+        let position = EndPose {
+            position: vec![(0, 0.4), (2, 0.7)],
+            angles: Vec::new(),
+        };
+        let mut p0 = position.problem(&base);
+        let from = p0.natural_start(0.1);
+        let start = solve_static(&mut p0, &from, &StaticOptions::default());
+        assert_eq!(start.status, SolveStatus::Converged);
+        let force = start.lambda[crate::optim::Nlp::m(&base)..].to_vec();
+        assert!(force.iter().any(|f| f.abs() > 0.1), "a bent rod: {force:?}");
+        let positions = model.evaluate(&start.a).positions;
+        let mut p = EndPose::of(model, &start.a, &positions).problem(&base);
+        let m = crate::optim::Nlp::m(&p);
+        assert_eq!(m, start.lambda.len() + 1, "the end's angle is one row more");
+        let lambda = warm_multipliers(&base, &start, &mut p);
+        let nb = crate::optim::Nlp::m(&base);
+        // The base rows as solved, the end's force as solved, no moment at the end.
+        assert_eq!(lambda[..nb], start.lambda[..nb]);
+        for (got, want) in lambda[nb..nb + 2].iter().zip(&force) {
+            assert!(
+                (got - want).abs() <= 1e-6 * want.abs().max(1.0),
+                "{got} vs {want}"
+            );
+        }
+        assert!(lambda[nb + 2].abs() <= 1e-6, "moment {}", lambda[nb + 2]);
+        let balanced = kkt_residual(&mut p, &start.a, &lambda);
+        assert!(balanced <= 1e-6, "{balanced:.3e}");
+        let mut zeroed = lambda.clone();
+        zeroed[nb..].iter_mut().for_each(|v| *v = 0.0);
+        let unbalanced = kkt_residual(&mut p, &start.a, &zeroed);
+        assert!(unbalanced > 1e3 * balanced.max(1e-9), "{unbalanced:.3e}");
+    }
 }

@@ -294,6 +294,29 @@ fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     );
 }
 
+/// The suite's planar problem `planar_1002_20` (seed 1002), planned with the defaults: its
+/// start is given by the end's position alone, the rod bent against a box. The replay's first
+/// solve, at the start pose with the end's angle held too, starts from the start shape with its
+/// own reactions (the end's force, no moment) and stays on it: the replay's first shape is the
+/// start shape, at its energy. With the end's force starting at zero, that solve settled 0.57 L
+/// away at 2.5 times the energy (16.8 against 6.78), and no plan from the start was executable.
+#[test]
+fn a_start_given_by_its_position_alone_is_replayed_from_its_own_shape() {
+    let (p, r) = suite_planar_plan_of(1002, 20);
+    let start = p.start.energy.internal();
+    assert!(
+        r.replay.start_held(),
+        "the replay starts {:.3} L from the start shape",
+        r.replay.start_deviation_over_l
+    );
+    let first = r.replay.steps[0].u_feasible;
+    assert!(
+        (first - start).abs() <= 1e-2 * start,
+        "{first} against {start}"
+    );
+    assert!(r.verdict().is_executable(), "{:?}", r.verdict());
+}
+
 /// The suite's planar problem `planar_16_60` (seed 16), planned with the defaults: after its
 /// sharpness stages the case's own plan, converged and collision-free, lies 0.45 L from the
 /// equilibria its samples' end poses produce (on another branch than its shapes), farther
