@@ -837,7 +837,13 @@ fn main() {
                             );
                         }
                         if let Some(why) = &o.why_not {
-                            eprintln!("{:16} not executable: {why}", o.name);
+                            // A departure's or a snap's verdict already says it.
+                            let lead = if why.starts_with("not executable") {
+                                ""
+                            } else {
+                                "not executable: "
+                            };
+                            eprintln!("{:16} {lead}{why}", o.name);
                         }
                     }
                     results[kind].push(o);
