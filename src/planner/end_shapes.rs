@@ -32,6 +32,21 @@ pub(super) fn end_grid(
     fine_model(model, END_GRID_REFINEMENT * s_intervals, 2)
 }
 
+/// Bending and twisting energy (units of `Rf/L`) above which an end shape solved from its first
+/// start is searched again from the other starts, as where that solve does not converge, and
+/// the lowest stable shape kept: twice that of a rod bent into one full circle (`2π²`). A local
+/// solve from the natural state can settle in a shape wound or rippled far beyond what the
+/// pose needs (on the generated suite, 577 where a stable shape of 5.3 holds the same pose),
+/// and every plan from it peaks at least that high; shapes bent this much are a few in a
+/// hundred, so the other starts' solves cost little ([`PlanSettings::least_energy_ends`]
+/// searches every end so).
+pub(super) const WOUND_ENERGY: f64 = 4.0 * std::f64::consts::PI * std::f64::consts::PI;
+
+/// Whether `sol`'s bending and twisting energy is above [`WOUND_ENERGY`].
+fn wound(sol: &StaticSolution) -> bool {
+    sol.energy_scaled.flexural + sol.energy_scaled.torsional > WOUND_ENERGY
+}
+
 /// The start or goal shape: `end`'s coefficients as given, or the static solve of its pose,
 /// started from its coefficients, else (a 3D end with all three angles) from a shape bent
 /// from the held frame `held` (see [`held_frame`]) towards its own, else from the case's
@@ -118,7 +133,7 @@ pub(super) fn end_shape(
         };
         let first = solved(&a0);
         let converged = first.0.status == SolveStatus::Converged;
-        if end.shape.is_some() || (converged && !least_energy) {
+        if end.shape.is_some() || (converged && !least_energy && !wound(&first.0)) {
             first
         } else {
             // Searched again from rods bent other ways: the lowest-energy shape that converges
