@@ -157,22 +157,30 @@ pub(super) fn end_shape(
             )
             .into_iter()
             .map(|a| solved(&a));
-            let key = |s: &StaticSolution| (s.stable != Some(true), s.energy.potential());
+            // Shapes clear of the obstacles on the end grid first (one that dips between its
+            // contact points ends every path inside the obstacle), then stable ones, then the
+            // least energy.
+            let tol = COLLISION_TOLERANCE * base.model.rod.length;
+            let dips = |s: &StaticSolution| {
+                verify::shape_worst_clearance(fine, &problem.obstacles, &s.a)
+                    .is_some_and(|w| w.clearance < -tol)
+            };
+            let key = |s: &StaticSolution| (dips(s), s.stable != Some(true), s.energy.potential());
             let best = retried
                 .filter(|(sol, _)| sol.status == SolveStatus::Converged)
-                .min_by(|(a, _), (b, _)| {
-                    let (ka, kb) = (key(a), key(b));
-                    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-                });
+                .map(|r| (key(&r.0), r))
+                .min_by(|(ka, _), (kb, _)| {
+                    (ka.0, ka.1).cmp(&(kb.0, kb.1)).then(ka.2.total_cmp(&kb.2))
+                })
+                .map(|(_, r)| r);
             match best {
-                // The first search's shape stays unless another is stable where it is not, or
-                // has less energy by more than the solves' last digits (the same equilibrium
-                // reached from another start).
+                // The first search's shape stays unless another is clear where it dips,
+                // stable where it is not, or has less energy by more than the solves' last
+                // digits (the same equilibrium reached from another start).
                 Some(b) if converged => {
                     let (kb, kf) = (key(&b.0), key(&first.0));
-                    let lower = kb.1 < kf.1 - 1e-9 * kf.1.abs().max(1.0);
-                    let stabler = !kb.0 && kf.0;
-                    if stabler || (kb.0 == kf.0 && lower) {
+                    let lower = kb.2 < kf.2 - 1e-9 * kf.2.abs().max(1.0);
+                    if (kb.0, kb.1) < (kf.0, kf.1) || ((kb.0, kb.1) == (kf.0, kf.1) && lower) {
                         b
                     } else {
                         first
