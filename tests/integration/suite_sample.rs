@@ -1479,6 +1479,40 @@ fn a_problem_scaled_by_a_power_of_two_plans_the_same_bit_for_bit() {
     }
 }
 
+/// Asserts that shapes `a` and `b` of `model` end at the same point, to 1e-9 L.
+fn assert_same_end_point(model: &dlo_planner::rod::model::Model, a: &[f64], b: &[f64]) {
+    let tip = |a: &[f64]| *model.evaluate(a).positions.last().expect("points");
+    let (x, y) = (tip(a), tip(b));
+    let l = model.rod.length;
+    assert!(
+        (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9 * l),
+        "{x:?} vs {y:?}"
+    );
+}
+
+/// The suite's planar problem `planar_{seed}_{i}`, and two planners of it on the case's own
+/// contact samples: one whose goal is solved from the natural state alone (given that start
+/// as its `shape`), as the first search of a pose runs, and the planner as it is.
+fn goal_from_the_natural_state(
+    seed: u64,
+    i: usize,
+) -> (
+    dlo_planner::case::Case,
+    dlo_planner::planner::Planner,
+    dlo_planner::planner::Planner,
+) {
+    use dlo_planner::planner::Planner;
+    let text = nth_problem(planar_problem, seed, i);
+    let name = format!("planar_{seed}_{i}.json");
+    let c = dlo_planner::case::parse(&text, std::path::Path::new(&name)).unwrap();
+    let (problem, settings) = dlo_planner::case::plan::plan_problem(&c).unwrap();
+    let mut natural = problem.clone();
+    natural.goal.shape = Some(problem.initial.clone());
+    let first = Planner::new(natural, settings.clone()).expect("start and goal solve");
+    let chosen = Planner::new(problem, settings).expect("start and goal solve");
+    (c, first, chosen)
+}
+
 /// The generator's `planar_99_25` (seed 99): its goal is a position only, and the solve from
 /// the natural state turns the rod more than once round (θ(L) = 5.73, bending energy 70.6,
 /// above twice that of a rod bent into a full circle, 4π²). Such an end is searched again from
@@ -1489,15 +1523,8 @@ fn a_problem_scaled_by_a_power_of_two_plans_the_same_bit_for_bit() {
 /// energy. The start, bent less, is the first solve's shape bit for bit.
 #[test]
 fn an_end_wound_far_beyond_its_pose_is_searched_again() {
-    use dlo_planner::planner::Planner;
     use dlo_planner::planner::verify::{fine_model, shape_worst_clearance};
-    let text = nth_problem(planar_problem, 99, 25);
-    let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_99_25.json")).unwrap();
-    let (problem, settings) = dlo_planner::case::plan::plan_problem(&c).unwrap();
-    let mut natural = problem.clone();
-    natural.goal.shape = Some(problem.initial.clone());
-    let first = Planner::new(natural, settings.clone()).expect("start and goal solve");
-    let chosen = Planner::new(problem, settings).expect("start and goal solve");
+    let (c, first, chosen) = goal_from_the_natural_state(99, 25);
     let model = &first.base.model;
     let l = model.rod.length;
     let bending = first.goal.energy_scaled.flexural + first.goal.energy_scaled.torsional;
@@ -1513,12 +1540,7 @@ fn an_end_wound_far_beyond_its_pose_is_searched_again() {
     );
     assert!(low < 0.1 * high, "{low} vs {high}");
     assert_eq!(chosen.goal.stable, Some(true));
-    let tip = |a: &[f64]| *model.evaluate(a).positions.last().expect("points");
-    let (x, y) = (tip(&first.goal.a), tip(&chosen.goal.a));
-    assert!(
-        (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9 * l),
-        "{x:?} vs {y:?}"
-    );
+    assert_same_end_point(model, &first.goal.a, &chosen.goal.a);
     let fine = fine_model(model, first.verify_s_intervals(), 4);
     let worst = shape_worst_clearance(&fine, &c.obstacles, &chosen.goal.a).expect("obstacles");
     assert!(worst.clearance >= -1e-6 * l, "{worst:?}");
@@ -1534,15 +1556,8 @@ fn an_end_wound_far_beyond_its_pose_is_searched_again() {
 /// clear first shape stays the goal, bit for bit, and is clear on the end grid.
 #[test]
 fn a_searched_end_keeps_a_clear_shape_over_one_that_dips() {
-    use dlo_planner::planner::Planner;
     use dlo_planner::planner::verify::{fine_model, shape_worst_clearance};
-    let text = nth_problem(planar_problem, 516, 34);
-    let c = dlo_planner::case::parse(&text, std::path::Path::new("planar_516_34.json")).unwrap();
-    let (problem, settings) = dlo_planner::case::plan::plan_problem(&c).unwrap();
-    let mut natural = problem.clone();
-    natural.goal.shape = Some(problem.initial.clone());
-    let first = Planner::new(natural, settings.clone()).expect("start and goal solve");
-    let chosen = Planner::new(problem, settings).expect("start and goal solve");
+    let (c, first, chosen) = goal_from_the_natural_state(516, 34);
     let bending = first.goal.energy_scaled.flexural + first.goal.energy_scaled.torsional;
     assert!(bending > 4.0 * std::f64::consts::PI.powi(2), "{bending}");
     assert_eq!(chosen.goal.a, first.goal.a);
@@ -1578,12 +1593,7 @@ fn least_energy_ends_take_the_lowest_stable_shape_of_the_starts() {
     );
     assert!(low < 0.5 * high, "{low} vs {high}");
     assert_eq!(least.start.stable, Some(true));
-    let tip = |a: &[f64]| *model.evaluate(a).positions.last().expect("points");
-    let (x, y) = (tip(&first.start.a), tip(&least.start.a));
-    assert!(
-        (0..3).all(|i| (x[i] - y[i]).abs() <= 1e-9 * l),
-        "{x:?} vs {y:?}"
-    );
+    assert_same_end_point(model, &first.start.a, &least.start.a);
     let (ta, tb) = (
         model.angles_at(&first.start.a, 1.0)[1],
         model.angles_at(&least.start.a, 1.0)[1],
