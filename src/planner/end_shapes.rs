@@ -34,7 +34,7 @@ pub(super) fn end_grid(
 
 /// Bending and twisting energy (units of `Rf/L`) above which an end shape solved from its first
 /// start is searched again from the other starts, as where that solve does not converge, and
-/// the lowest stable shape kept: twice that of a rod bent into one full circle (`2π²`). A local
+/// the lowest stable shape kept: `4π²`, twice that of a rod bent into one full circle. A local
 /// solve from the natural state can settle in a shape wound or rippled far beyond what the
 /// pose needs (on the generated suite, 577 where a stable shape of 5.3 holds the same pose),
 /// and every plan from it peaks at least that high; shapes bent this much are a few in a
