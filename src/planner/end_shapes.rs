@@ -161,24 +161,22 @@ pub(super) fn end_shape(
             // contact points ends every path inside the obstacle), then stable ones, then the
             // least energy.
             let tol = COLLISION_TOLERANCE * base.model.rod.length;
-            let dips = |s: &StaticSolution| {
-                verify::shape_worst_clearance(fine, &problem.obstacles, &s.a)
-                    .is_some_and(|w| w.clearance < -tol)
+            let key = |s: &StaticSolution| {
+                let dips = end_clearance(fine, &problem.obstacles, &s.a) < -tol;
+                (dips, s.stable != Some(true), s.energy.potential())
             };
-            let key = |s: &StaticSolution| (dips(s), s.stable != Some(true), s.energy.potential());
             let best = retried
                 .filter(|(sol, _)| sol.status == SolveStatus::Converged)
                 .map(|r| (key(&r.0), r))
                 .min_by(|(ka, _), (kb, _)| {
                     (ka.0, ka.1).cmp(&(kb.0, kb.1)).then(ka.2.total_cmp(&kb.2))
-                })
-                .map(|(_, r)| r);
+                });
             match best {
                 // The first search's shape stays unless another is clear where it dips,
                 // stable where it is not, or has less energy by more than the solves' last
                 // digits (the same equilibrium reached from another start).
-                Some(b) if converged => {
-                    let (kb, kf) = (key(&b.0), key(&first.0));
+                Some((kb, b)) if converged => {
+                    let kf = key(&first.0);
                     let lower = kb.2 < kf.2 - 1e-9 * kf.2.abs().max(1.0);
                     if (kb.0, kb.1) < (kf.0, kf.1) || ((kb.0, kb.1) == (kf.0, kf.1) && lower) {
                         b
@@ -186,7 +184,7 @@ pub(super) fn end_shape(
                         first
                     }
                 }
-                Some(b) => b,
+                Some((_, b)) => b,
                 None => first,
             }
         }
@@ -260,6 +258,12 @@ pub(super) fn solve_warm_from(
     crate::statics::solve_static_warm(p, a, &lambda, opts)
 }
 
+/// The smallest clearance (case units) of the shape `a` from `obstacles` on the end grid
+/// `fine` ([`end_grid`]); infinite where there is no obstacle.
+fn end_clearance(fine: &crate::rod::model::Model, obstacles: &[Arc<Obstacle>], a: &[f64]) -> f64 {
+    verify::shape_worst_clearance(fine, obstacles, a).map_or(f64::INFINITY, |w| w.clearance)
+}
+
 /// An end shape `sol` solved at `pose` with its obstacle contacts at the sample points, or,
 /// where it dips into an obstacle between them on the end grid `fine` ([`end_grid`]; by more
 /// than the collision tolerance, 1e-6 L) and the same pose solved with the contacts on the
@@ -290,9 +294,7 @@ pub(super) fn on_chords_if_dipping(
         }
     };
     let tol = COLLISION_TOLERANCE * statics.model.rod.length;
-    let depth = |a: &[f64]| {
-        verify::shape_worst_clearance(fine, obstacles, a).map_or(f64::INFINITY, |w| w.clearance)
-    };
+    let depth = |a: &[f64]| end_clearance(fine, obstacles, a);
     if sol.status != SolveStatus::Converged || depth(&sol.a) >= -tol {
         return (sol, None);
     }

@@ -108,6 +108,22 @@ fn fixed_targets(mut fields: serde_json::Value) -> serde_json::Value {
     fields
 }
 
+/// The suite's planar problem `planar_{seed}_{i}` as a case, with the `plan` settings `fields`
+/// and the defaults otherwise.
+fn suite_planar_case_with(
+    seed: u64,
+    i: usize,
+    fields: serde_json::Value,
+) -> dlo_planner::case::Case {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&nth_problem(planar_problem, seed, i)).expect("generated JSON");
+    for (key, val) in fields.as_object().expect("an object") {
+        v["plan"][key] = val.clone();
+    }
+    let path = format!("planning_cases/planar_{i}.json");
+    dlo_planner::case::parse(&v.to_string(), std::path::Path::new(&path)).expect("a generated case")
+}
+
 /// The suite's planar problem `planar_{seed}_{i}`, planned with the `plan` settings `fields`
 /// and the defaults otherwise.
 fn suite_planar_plan_with(
@@ -118,17 +134,9 @@ fn suite_planar_plan_with(
     dlo_planner::planner::Planner,
     dlo_planner::planner::PlanResult,
 ) {
-    use dlo_planner::case;
     use dlo_planner::planner::Planner;
     use dlo_planner::planner::observer::Silent;
-    let mut v: serde_json::Value =
-        serde_json::from_str(&nth_problem(planar_problem, seed, i)).expect("generated JSON");
-    for (key, val) in fields.as_object().expect("an object") {
-        v["plan"][key] = val.clone();
-    }
-    let text = v.to_string();
-    let path = format!("planning_cases/planar_{i}.json");
-    let c = case::parse(&text, std::path::Path::new(&path)).expect("a generated case");
+    let c = suite_planar_case_with(seed, i, fields);
     let p = Planner::from_case(&c).expect("start and goal solve");
     let r = p.run(&mut Silent);
     (p, r)
@@ -710,10 +718,7 @@ fn a_straight_route_that_swings_the_gripper_far_round_is_left_to_the_optimiser()
     use dlo_planner::case;
     use dlo_planner::planner::observer::Silent;
     use dlo_planner::planner::trajectory::Trajectory;
-    let mut v: serde_json::Value =
-        serde_json::from_str(&nth_problem(planar_problem, 31, 39)).expect("generated JSON");
-    v["plan"]["equilibrium_slopes"] = false.into();
-    let c = case::parse(&v.to_string(), std::path::Path::new("planar_39.json")).expect("a case");
+    let c = suite_planar_case_with(31, 39, fixed_targets(serde_json::json!({})));
     let (mut problem, settings) = case::plan::plan_problem(&c).expect("a plan");
     problem.goal.shape = Some(problem.initial.clone());
     let p = case::plan::planner(&c, problem, settings).expect("start and goal solve");
