@@ -43,7 +43,7 @@ use end_shapes::{end_grid, end_shape, held_frame};
 pub use endpoints::End;
 use minimax::MinimaxProblem;
 use observer::PlanObserver;
-pub use settings::{Optimiser, PlanSettings, PoseOptimisation, Workspace};
+pub use settings::{EarlyStages, Optimiser, PlanSettings, PoseOptimisation, Workspace};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -19,6 +19,13 @@ use std::sync::Arc;
 /// than a tenth, and which local minimum the paper's case reaches changed.)
 const EARLY_STAGE_OPTIMALITY: f64 = 1e-3;
 
+/// Optimality tolerance of the sharpness stages before the last in a planar rod's own attempt
+/// (feasibility: a tenth of it), whose stages restart BFGS and the penalty: on the generated
+/// suite's planar problems (65 seeds, 2026-12-07) the plans over 0.5 s fell from 239 to 171 of
+/// 3,900; on 12 of those seeds from 43 to 32, against 38 with 1e-3, 42 with 1e-4 and 31 with
+/// 1e-1 (docs/notes/speed-alternatives.md).
+const OWN_EARLY_STAGE_OPTIMALITY: f64 = 1e-2;
+
 /// A quick start's continuation also ends at the first converged stage whose samples peak
 /// inside the path more than this fraction above the larger end energy: on the generated suite
 /// (seeds 1–6, 256 quick starts) every quick plan that attained the lower bound did so in its
@@ -259,16 +266,26 @@ impl Planner {
                 break;
             }
             p.beta = b / u_ref;
-            // On a 3D rod, stages before the sharpest only carry the path to the next one.
-            let al = if self.base.model.layout.spatial && stage + 1 < self.settings.sharpness.len()
-            {
-                AlOptions {
-                    optimality_tol: EARLY_STAGE_OPTIMALITY,
-                    feasibility_tol: 0.1 * EARLY_STAGE_OPTIMALITY,
+            // With loose early stages, the stages before the sharpest only carry the path to
+            // the next one: on a 3D rod, and in a planar rod's own attempt (its stages
+            // restarted); the other planar attempts' stages carry the curvature and are cheap.
+            let early = (stage + 1 < self.settings.sharpness.len()
+                && self.settings.early_stages == settings::EarlyStages::Loose)
+                .then(|| {
+                    if self.base.model.layout.spatial {
+                        Some(EARLY_STAGE_OPTIMALITY)
+                    } else {
+                        (!carry).then_some(OWN_EARLY_STAGE_OPTIMALITY)
+                    }
+                })
+                .flatten();
+            let al = match early {
+                Some(tol) => AlOptions {
+                    optimality_tol: tol,
+                    feasibility_tol: 0.1 * tol,
                     ..al
-                }
-            } else {
-                al
+                },
+                None => al,
             };
             let al = AlOptions {
                 rho_initial: rho,

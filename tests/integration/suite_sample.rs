@@ -108,6 +108,14 @@ fn fixed_targets(mut fields: serde_json::Value) -> serde_json::Value {
     fields
 }
 
+/// `fields` with every sharpness stage converged fully (`"early_stages": "exact"`). The
+/// scenarios that need a case's own plan that is not executable take them; with the default
+/// loose early stages the own attempts of those problems take routes they execute.
+fn exact_stages(mut fields: serde_json::Value) -> serde_json::Value {
+    fields["early_stages"] = "exact".into();
+    fields
+}
+
 /// The suite's planar problem `planar_{seed}_{i}` as a case, with the `plan` settings `fields`
 /// and the defaults otherwise.
 fn suite_planar_case_with(
@@ -246,8 +254,8 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
 }
 
 /// The suite's planar problem `planar_902_4` (seed 902), planned with fixed tracking targets
-/// ([`fixed_targets`]; with the defaults the case's own plan is executable and nothing is
-/// lifted): neither
+/// ([`fixed_targets`]) and exact stages ([`exact_stages`]; with the defaults the case's own
+/// plan is executable and nothing is lifted): neither
 /// the quick attempt's plan nor the case's own attains the lower bound on U_max (both peak
 /// inside the path), and the own plan, converged and collision-free, lies farther than the
 /// coincidence tolerance from its equilibria (5.6 % of L measured). That path lifted to the
@@ -261,7 +269,7 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
 #[test]
 fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     use dlo_planner::planner::Attempt;
-    let (p, r) = suite_planar_plan_with(902, 4, fixed_targets(serde_json::json!({})));
+    let (p, r) = suite_planar_plan_with(902, 4, exact_stages(fixed_targets(serde_json::json!({}))));
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
     let (own, lifted) = (&r.starts[1], &r.starts[2]);
@@ -285,8 +293,11 @@ fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     assert_eq!((lifted.path_terms, r.path_terms), (terms, terms));
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= tol);
-    let (_, unlifted) =
-        suite_planar_plan_with(902, 4, fixed_targets(serde_json::json!({ "lift": false })));
+    let (_, unlifted) = suite_planar_plan_with(
+        902,
+        4,
+        exact_stages(fixed_targets(serde_json::json!({ "lift": false }))),
+    );
     assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
     assert!(
         unlifted
@@ -325,8 +336,9 @@ fn a_start_given_by_its_position_alone_is_replayed_from_its_own_shape() {
     assert!(r.verdict().is_executable(), "{:?}", r.verdict());
 }
 
-/// The suite's planar problem `planar_16_60` (seed 16), planned with the defaults: after its
-/// sharpness stages the case's own plan, converged and collision-free, lies 0.45 L from the
+/// The suite's planar problem `planar_16_60` (seed 16), planned with exact stages
+/// ([`exact_stages`]; with the defaults the case's own plan lies 0.005 L from its equilibria
+/// and is executable): after its sharpness stages the case's own plan, converged and collision-free, lies 0.45 L from the
 /// equilibria its samples' end poses produce (on another branch than its shapes), farther
 /// than the 0.25 L from which equilibrium tracking does not start: no round runs on it, it
 /// reports that distance, and it is not lifted to more path terms (whose tracking would not
@@ -335,7 +347,7 @@ fn a_start_given_by_its_position_alone_is_replayed_from_its_own_shape() {
 #[test]
 fn a_path_far_from_its_equilibria_is_not_tracked() {
     use dlo_planner::planner::Attempt;
-    let (_, r) = suite_planar_plan_of(16, 60);
+    let (_, r) = suite_planar_plan_with(16, 60, exact_stages(serde_json::json!({})));
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Fallback]);
     let own = &r.starts[1];
@@ -353,6 +365,39 @@ fn a_path_far_from_its_equilibria_is_not_tracked() {
     for s in r.starts.iter().filter(|s| s.tracking_rounds > 0) {
         assert!(s.equilibrium_deviation.expect("measured") <= 0.25, "{s:?}");
     }
+}
+
+/// The suite's planar problem `planar_16_60` again, with the defaults: the case's own stages
+/// before the sharpest stop at the loose tolerance, and its plan, tracked onto its equilibria,
+/// is executable and coincides with its replay, so no fallback runs; the own attempt uses
+/// fewer evaluations than with exact stages, whose plan needs the fallback (above). The plan is
+/// checked on 801 values of k and 1024 intervals in s: clearance at least −1e-6 L, largest
+/// energy the reported U_max to 1e-3.
+#[test]
+fn loose_early_stages_give_the_own_attempt_a_route_it_executes() {
+    use dlo_planner::planner::Attempt;
+    let (p, r) = suite_planar_plan_of(16, 60);
+    let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
+    assert_eq!(kinds, [Attempt::Quick, Attempt::Own]);
+    assert_eq!(r.executed_path(), Some("optimal"));
+    assert!(r.replay.coincide && r.replay.max_deviation_over_l <= r.replay.tolerance);
+    let l = p.base.model.rod.length;
+    let v = on_a_finer_grid(&p, &r);
+    assert!(v.min_clearance.expect("an obstacle") >= -1e-6 * l);
+    assert!(
+        (v.u_max - r.u_max).abs() <= 1e-3 * r.u_max,
+        "{} vs {}",
+        v.u_max,
+        r.u_max
+    );
+    let (_, exact) = suite_planar_plan_with(16, 60, exact_stages(serde_json::json!({})));
+    assert_eq!(exact.starts[1].attempt, Attempt::Own);
+    assert!(
+        r.starts[1].evaluations < exact.starts[1].evaluations,
+        "{} vs {}",
+        r.starts[1].evaluations,
+        exact.starts[1].evaluations
+    );
 }
 
 /// The suite's planar problem `planar_4_18` (seed 4), planned with the defaults: the quick
@@ -421,7 +466,7 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
 }
 
 /// The suite's planar problem `planar_13_14` (seed 13): a thin bar (a capsule of radius 0.031 L)
-/// across the swing of a heavy strip. With the defaults, the case's own attempt (3 path terms,
+/// across the swing of a heavy strip. With exact stages, the case's own attempt (3 path terms,
 /// no swept rows) tunnels through the bar between its samples, which the verification grid
 /// finds; the next attempt (6 path terms) then holds the swept-clearance rows, and its plan is
 /// collision-free and coincides with its replay. Checked independently of the planner's grid:
@@ -430,10 +475,16 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
 /// of it (2.1e-4 measured: the peak between the report's 201 grid values). (With
 /// `"swept_clearance": false`, every attempt tunnelled and the plan was a collision.) The
 /// scenario is the case's own attempt's, so the quick attempt is left out: with it, the quick
-/// plan attains the lower bound on U_max clear of the bar, and the search ends there.
+/// plan attains the lower bound on U_max clear of the bar, and the search ends there. It is also
+/// the exact stages' ([`exact_stages`]): with the default loose early stages the own plan is
+/// already clear of the bar.
 #[test]
 fn attempts_after_one_that_tunnels_hold_the_swept_rows() {
-    let (p, r) = suite_planar_plan_with(13, 14, serde_json::json!({ "quick_attempt": false }));
+    let (p, r) = suite_planar_plan_with(
+        13,
+        14,
+        exact_stages(serde_json::json!({ "quick_attempt": false })),
+    );
     let own = &r.starts[0];
     assert!(!own.swept_clearance && !own.collision_free, "{own:?}");
     let chosen = r
