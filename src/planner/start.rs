@@ -245,6 +245,17 @@ impl Planner {
         let mut first_progress = (self.quick && from.stage == 0).then(Vec::new);
         let mut first_stage = None;
         let carry = self.stages_carry_curvature();
+        // With loose early stages, the stages before the sharpest stop at this tolerance: they
+        // only carry the path to the next one. On a 3D rod, and in a planar rod's own attempt
+        // (its stages restarted); the other planar attempts' stages carry the curvature and
+        // are cheap.
+        let early_tol = match self.settings.early_stages {
+            settings::EarlyStages::Exact => None,
+            settings::EarlyStages::Loose if self.base.model.layout.spatial => {
+                Some(EARLY_STAGE_OPTIMALITY)
+            }
+            settings::EarlyStages::Loose => (!carry).then_some(OWN_EARLY_STAGE_OPTIMALITY),
+        };
         // BFGS's inverse-Hessian approximation (empty: a scaled identity), and the penalty.
         let (mut hinv, mut rho) = if carry && !from.curvature.hinv.is_empty() {
             (from.curvature.hinv, from.curvature.rho)
@@ -267,19 +278,7 @@ impl Planner {
                 break;
             }
             p.beta = b / u_ref;
-            // With loose early stages, the stages before the sharpest only carry the path to
-            // the next one: on a 3D rod, and in a planar rod's own attempt (its stages
-            // restarted); the other planar attempts' stages carry the curvature and are cheap.
-            let early = (stage + 1 < self.settings.sharpness.len()
-                && self.settings.early_stages == settings::EarlyStages::Loose)
-                .then(|| {
-                    if self.base.model.layout.spatial {
-                        Some(EARLY_STAGE_OPTIMALITY)
-                    } else {
-                        (!carry).then_some(OWN_EARLY_STAGE_OPTIMALITY)
-                    }
-                })
-                .flatten();
+            let early = early_tol.filter(|_| stage + 1 < self.settings.sharpness.len());
             let al = match early {
                 Some(tol) => AlOptions {
                     optimality_tol: tol,
