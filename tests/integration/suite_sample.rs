@@ -3,9 +3,18 @@
 //! from seed 1, named by their place in its sequence.
 
 use crate::suite::{
-    Outcome, Rng, hanging_problem, in_units, merge, planar_problem, run, spatial_problem,
-    table_problem,
+    Outcome, Rng, hanging_problem, in_units, merge, parse_seeds, planar_problem, run,
+    spatial_problem, table_problem,
 };
+
+/// `--seeds` takes single seeds and inclusive ranges, in the order given (the runner's other
+/// inputs it refuses with exit 2, not tested here: that exits the process).
+#[test]
+fn the_runner_reads_a_list_of_seeds_and_ranges() {
+    assert_eq!(parse_seeds("7"), [7]);
+    assert_eq!(parse_seeds("1-3,21,500-501"), [1, 2, 3, 21, 500, 501]);
+    assert_eq!(parse_seeds("4-4, 9"), [4, 9]);
+}
 
 /// Problem `index` of `generate` from seed `seed`: the text of the case it draws after the
 /// problems before it.
