@@ -454,6 +454,7 @@ pub fn in_units(text: &str, length: f64, rigidity: f64) -> String {
     for end in ["start", "goal"] {
         scale(&mut v["plan"][end], &lengths, length);
     }
+    scale(&mut v["plan"], &["safety_margin"], length);
     serde_json::to_string_pretty(&v).expect("JSON")
 }
 

@@ -480,7 +480,8 @@ impl Planner {
     /// The optimiser's extra clearance from obstacles in units of `L` (see
     /// [`PlanSettings::safety`]).
     pub fn safety(&self) -> f64 {
-        self.settings.safety(self.base.model.rod.length)
+        let model = &self.base.model;
+        self.settings.safety(model.rod.length, model.layout.spatial)
     }
 
     /// The start and the goal shape's worst clearances to the obstacles on the end grid

@@ -32,7 +32,8 @@ pub struct PlanSettings {
     /// thinner rod's grid is finer ([`PlanSettings::verify_s_for`]).
     pub verify_s_samples: usize,
     /// Extra clearance (case length units) the optimiser keeps from obstacles, so that the path
-    /// between its samples stays clear. Default `L/100`.
+    /// between its samples stays clear. Default `L/50` on a planar rod, `L/100` on a 3D one
+    /// ([`PlanSettings::safety`]).
     pub safety_margin: Option<f64>,
     /// Weight of the mean energy along the path in the objective (docs/algorithms.md, step 4).
     pub mean_weight: f64,
@@ -236,6 +237,20 @@ use crate::error::{Num, SettingsError};
 /// The largest [`PlanSettings::time_limit`] (seconds): beyond it, leave the limit out.
 pub const MAX_TIME_LIMIT: f64 = 1e6;
 
+/// The default safety margin of a planar rod's optimiser, in units of `L`: the samples keep it
+/// from the obstacles, and it is what keeps the path clear between them. On the generated
+/// suite's planar problems a margin of L/50 instead of L/100 left fewer paths tunnelling
+/// between samples, so fewer refinement reruns and fallback attempts ran and the slowest
+/// plans took about half as long, at the price of routes a little farther from the obstacles
+/// (U_max 0.4–0.5 % higher on the geometric mean; docs/notes/speed-alternatives.md, *A wider
+/// safety margin*).
+pub const PLANAR_SAFETY: f64 = 0.02;
+
+/// The default safety margin of a 3D rod's optimiser, in units of `L`. L/50 gained nothing on
+/// the generated suite's 3D problems (fewer optimal paths coinciding, no faster; see
+/// [`PLANAR_SAFETY`]).
+pub const SPATIAL_SAFETY: f64 = 0.01;
+
 /// Checks a [`PlanSettings::time_limit`] of `t` seconds: positive, finite and at most
 /// [`MAX_TIME_LIMIT`] (the error's field is `time_limit`; `dlo plan --time-limit` checks its
 /// value here too).
@@ -363,7 +378,8 @@ impl PlanSettings {
                 "at most 50 sharpness stages and 8 fallback path-term counts",
             ));
         }
-        let safety = self.safety_margin.unwrap_or(l / 100.0);
+        // (The defaults lie in range.)
+        let safety = self.safety_margin.unwrap_or(0.0);
         if !(0.0..=0.25 * l).contains(&finite("safety_margin", safety)?) {
             return Err(bad(
                 "safety_margin",
@@ -438,9 +454,14 @@ impl PlanSettings {
     }
 
     /// The optimiser's extra clearance from obstacles in units of `L`: `safety_margin`, or
-    /// `L/100` when it is not set.
-    pub fn safety(&self, length: f64) -> f64 {
-        self.safety_margin.unwrap_or(length / 100.0) / length
+    /// when it is not set [`PLANAR_SAFETY`] on a planar rod and [`SPATIAL_SAFETY`] on a 3D one.
+    pub fn safety(&self, length: f64, spatial: bool) -> f64 {
+        let default = if spatial {
+            SPATIAL_SAFETY
+        } else {
+            PLANAR_SAFETY
+        };
+        self.safety_margin.map_or(default, |m| m / length)
     }
 
     /// The path-term counts tried after `path_terms`: `fallback_path_terms`, or by default

@@ -125,6 +125,15 @@ fn exact_stages(mut fields: serde_json::Value) -> serde_json::Value {
     fields
 }
 
+/// `fields` with the optimiser's safety margin at L/100 (`"safety_margin": 0.01`, the suite's
+/// rods being 1 long; a 3D rod's default) instead of a planar rod's default L/50. The
+/// scenarios that need a planar path tunnelling between its samples, or a route that the
+/// wider margin closes, take it; with the planar default these problems plan otherwise.
+fn narrow_margin(mut fields: serde_json::Value) -> serde_json::Value {
+    fields["safety_margin"] = 0.01.into();
+    fields
+}
+
 /// The suite's planar problem `planar_{seed}_{i}` as a case, with the `plan` settings `fields`
 /// and the defaults otherwise.
 fn suite_planar_case_with(
@@ -254,7 +263,7 @@ fn a_quick_plan_at_the_lower_bound_ends_the_search() {
 #[test]
 fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
     use dlo_planner::planner::Attempt;
-    let (p, r) = suite_planar_plan_of(900, 53);
+    let (p, r) = suite_planar_plan_with(900, 53, narrow_margin(serde_json::json!({})));
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Lifted]);
     let (quick, lifted) = (&r.starts[0], &r.starts[1]);
@@ -271,7 +280,8 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
     assert_eq!(r.executed_path(), Some("optimal"));
     assert!(r.replay.coincide && r.replay.max_deviation_over_l <= tol);
     attains_the_bound_clear_of_obstacles(&p, &r);
-    let (_, unlifted) = suite_planar_plan_with(900, 53, serde_json::json!({ "lift": false }));
+    let (_, unlifted) =
+        suite_planar_plan_with(900, 53, narrow_margin(serde_json::json!({ "lift": false })));
     assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
     assert!(unlifted.starts.iter().any(|s| s.attempt == Attempt::Own));
     assert!(
@@ -298,7 +308,11 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
 #[test]
 fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     use dlo_planner::planner::Attempt;
-    let (p, r) = suite_planar_plan_with(902, 4, exact_stages(fixed_targets(serde_json::json!({}))));
+    let (p, r) = suite_planar_plan_with(
+        902,
+        4,
+        narrow_margin(exact_stages(fixed_targets(serde_json::json!({})))),
+    );
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Lifted]);
     let (own, lifted) = (&r.starts[1], &r.starts[2]);
@@ -317,7 +331,9 @@ fn a_converged_own_plan_that_departs_is_lifted_to_more_path_terms() {
     let (_, unlifted) = suite_planar_plan_with(
         902,
         4,
-        exact_stages(fixed_targets(serde_json::json!({ "lift": false }))),
+        narrow_margin(exact_stages(fixed_targets(
+            serde_json::json!({ "lift": false }),
+        ))),
     );
     assert!(unlifted.starts.iter().all(|s| s.attempt != Attempt::Lifted));
     assert!(
@@ -368,7 +384,7 @@ fn a_start_given_by_its_position_alone_is_replayed_from_its_own_shape() {
 #[test]
 fn a_path_far_from_its_equilibria_is_not_tracked() {
     use dlo_planner::planner::Attempt;
-    let (_, r) = suite_planar_plan_with(16, 60, exact_stages(serde_json::json!({})));
+    let (_, r) = suite_planar_plan_with(16, 60, narrow_margin(exact_stages(serde_json::json!({}))));
     let kinds: Vec<Attempt> = r.starts.iter().map(|s| s.attempt).collect();
     assert_eq!(kinds, [Attempt::Quick, Attempt::Own, Attempt::Fallback]);
     let own = &r.starts[1];
@@ -488,7 +504,7 @@ fn attempts_after_one_that_tunnels_hold_the_swept_rows() {
     let (p, r) = suite_planar_plan_with(
         13,
         14,
-        exact_stages(serde_json::json!({ "quick_attempt": false })),
+        narrow_margin(exact_stages(serde_json::json!({ "quick_attempt": false }))),
     );
     let own = &r.starts[0];
     assert!(!own.swept_clearance && !own.collision_free, "{own:?}");
@@ -637,7 +653,7 @@ fn held_off_on_chords(
 /// ending on the goal shape, no shape inside an obstacle on a grid four times finer in s.
 #[test]
 fn equilibria_that_dip_on_chords_too_are_held_off_by_twice_the_depth() {
-    let fields = fixed_targets(serde_json::json!({ "quick_attempt": false }));
+    let fields = narrow_margin(fixed_targets(serde_json::json!({ "quick_attempt": false })));
     let (p, r) = suite_planar_plan_with(1, 8, fields);
     assert_eq!(r.executed_path(), Some("equilibria"));
     let e = r.equilibrium_plan.as_ref().expect("checked");
@@ -1092,7 +1108,7 @@ fn equilibria_dipping_between_chords_are_replayed_on_twice_the_contact_samples()
     use dlo_planner::planner::verify::fine_model;
     let mut v: serde_json::Value =
         serde_json::from_str(&nth_problem(hanging_problem, 1, 20)).expect("JSON");
-    v["plan"] = fixed_targets(v["plan"].clone());
+    v["plan"] = narrow_margin(fixed_targets(v["plan"].clone()));
     let text = v.to_string();
     let c = dlo_planner::case::parse(&text, std::path::Path::new("planning_cases/hanging.json"))
         .expect("a generated case");
@@ -1671,14 +1687,23 @@ fn least_energy_ends_take_the_lowest_stable_shape_of_the_starts() {
 /// the same verdict and attempts, U_max scaled by `Rf / L` and the gripper's travel ratio
 /// equal, to 1e-6 relative (the planner works in units of L; the scaled inputs differ from
 /// the scaled-back ones in their last digits). Planar problems 0 (optimised, quick attempt)
-/// and 2 (with weight, the straight path) of seed 1, and the 3D generator's first.
+/// and 2 (with weight, the straight path) of seed 1, and the 3D generator's first. The planar
+/// ones keep a safety margin of L/100 ([`narrow_margin`], scaled with the rest): with a planar
+/// rod's default L/50, problem 0's quick plan reaches the same U_max (to 1e-6) but its
+/// gripper travel differs by 8e-4 relative, the travel term's tie-break being flat there to
+/// within the optimiser's tolerance.
 #[test]
 fn a_problem_in_other_units_plans_the_same() {
     let none = serde_json::json!({});
     let (l, rf) = (0.6, 0.02);
+    let narrow = |text: String| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+        v["plan"] = narrow_margin(v["plan"].clone());
+        v.to_string()
+    };
     for (text, name) in [
-        (nth_problem(planar_problem, 1, 0), "planar_0"),
-        (nth_problem(planar_problem, 1, 2), "planar_2"),
+        (narrow(nth_problem(planar_problem, 1, 0)), "planar_0"),
+        (narrow(nth_problem(planar_problem, 1, 2)), "planar_2"),
         (nth_problem(spatial_problem, 1, 0), "spatial_0"),
     ] {
         let base = run(&text, name, &none, &none).expect("static ends");
