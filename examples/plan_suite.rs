@@ -753,6 +753,19 @@ fn main() {
             None => text,
         }
     };
+    // The table of both kinds' outcomes (a kind not planned, `--only`, has no row).
+    let print_table = |out: &[Vec<Outcome>; 2]| {
+        println!(
+            "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|");
+        if n_planar > 0 && only.is_none_or(|o| o == 0) {
+            print!("{}", table(planar_kind, &out[0]));
+        }
+        if n_spatial > 0 && only.is_none_or(|o| o == 1) {
+            print!("{}", table(spatial_label, &out[1]));
+        }
+    };
     let mut all: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut per_seed_p95: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
     for &seed in &seeds {
@@ -908,17 +921,7 @@ fn main() {
                 String::new()
             }
         );
-        println!(
-            "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
-        );
-        println!("|---|---|---|---|---|---|---|---|---|---|");
-        // (A kind not planned, `--only`, has no row.)
-        if n_planar > 0 && only.is_none_or(|o| o == 0) {
-            print!("{}", table(planar_kind, &results[0]));
-        }
-        if n_spatial > 0 && only.is_none_or(|o| o == 1) {
-            print!("{}", table(spatial_label, &results[1]));
-        }
+        print_table(&results);
         for (kind, out) in results.into_iter().enumerate() {
             let mut times: Vec<f64> = out.iter().map(|o| o.seconds).collect();
             per_seed_p95[kind].push(percentile(&mut times, 0.95));
@@ -937,16 +940,7 @@ fn main() {
             all[0].len(),
             all[1].len(),
         );
-        println!(
-            "| problems | n | collision-free | coincide with replay | executable | replay snaps | median time | 95th pct time | worst false collision-free | gripper travel / straight (median / 95th) |"
-        );
-        println!("|---|---|---|---|---|---|---|---|---|---|");
-        if n_planar > 0 && only.is_none_or(|o| o == 0) {
-            print!("{}", table(planar_kind, &all[0]));
-        }
-        if n_spatial > 0 && only.is_none_or(|o| o == 1) {
-            print!("{}", table(spatial_label, &all[1]));
-        }
+        print_table(&all);
         // Against the 95th-percentile targets of the suite (docs/results.md): per seed, and
         // pooled as the count of plans over the limit against the 5 % it allows.
         println!();
