@@ -240,9 +240,9 @@ pub const MAX_TIME_LIMIT: f64 = 1e6;
 /// The default safety margin of a planar rod's optimiser, in units of `L`: the samples keep it
 /// from the obstacles, and it is what keeps the path clear between them. On the generated
 /// suite's planar problems a margin of L/50 instead of L/100 left fewer paths tunnelling
-/// between samples, so fewer refinement reruns and fallback attempts ran and the slowest
-/// plans took about half as long, at the price of routes a little farther from the obstacles
-/// (U_max 0.4–0.5 % higher on the geometric mean; docs/notes/speed-alternatives.md, *A wider
+/// between samples, so fewer refinement reruns and fallback attempts ran (99 of 3,900 plans
+/// over 0.5 s instead of 168), at the price of routes a little farther from the obstacles
+/// (U_max 0.48 % higher on the geometric mean; docs/notes/speed-alternatives.md, *A wider
 /// safety margin*).
 pub const PLANAR_SAFETY: f64 = 0.02;
 

@@ -251,7 +251,8 @@ fn a_quick_plan_at_the_lower_bound_ends_the_search() {
     );
 }
 
-/// The suite's planar problem `planar_900_53` (seed 900), planned with the defaults: the quick
+/// The suite's planar problem `planar_900_53` (seed 900), planned with a margin of L/100
+/// ([`narrow_margin`]) and the defaults otherwise: the quick
 /// attempt's plan attains the lower bound on U_max and is collision-free, but its sampled
 /// shapes lie farther than the coincidence tolerance from their equilibria (11 % of L
 /// measured). The same path lifted to the first fallback count's path terms and tracked again
@@ -292,7 +293,8 @@ fn a_quick_plan_at_the_bound_that_departs_is_lifted_to_more_path_terms() {
     );
 }
 
-/// The suite's planar problem `planar_902_4` (seed 902), planned with fixed tracking targets
+/// The suite's planar problem `planar_902_4` (seed 902), planned with a margin of L/100
+/// ([`narrow_margin`]), fixed tracking targets
 /// ([`fixed_targets`]) and exact stages ([`exact_stages`]; with the defaults the case's own
 /// plan is executable and nothing is lifted): neither
 /// the quick attempt's plan nor the case's own attains the lower bound on U_max (both peak
@@ -373,7 +375,8 @@ fn a_start_given_by_its_position_alone_is_replayed_from_its_own_shape() {
     assert!(r.verdict().is_executable(), "{:?}", r.verdict());
 }
 
-/// The suite's planar problem `planar_16_60` (seed 16), planned with exact stages
+/// The suite's planar problem `planar_16_60` (seed 16), planned with a margin of L/100
+/// ([`narrow_margin`]) and exact stages
 /// ([`exact_stages`]; with the defaults the case's own plan lies 0.005 L from its equilibria
 /// and is executable): after its sharpness stages the case's own plan, converged and collision-free, lies 0.45 L from the
 /// equilibria its samples' end poses produce (on another branch than its shapes), farther
@@ -486,7 +489,8 @@ fn replayed_equilibria_are_the_plan_where_the_optimal_path_departs() {
     held_on_the_trajectory_clear_of_obstacles(&p, &r);
 }
 
-/// The suite's planar problem `planar_13_14` (seed 13): a thin bar (a capsule of radius 0.031 L)
+/// The suite's planar problem `planar_13_14` (seed 13), with a margin of L/100
+/// ([`narrow_margin`]): a thin bar (a capsule of radius 0.031 L)
 /// across the swing of a heavy strip. With exact stages, the case's own attempt (3 path terms,
 /// no swept rows) tunnels through the bar between its samples, which the verification grid
 /// finds; the next attempt (6 path terms) then holds the swept-clearance rows, and its plan is
@@ -643,7 +647,8 @@ fn held_off_on_chords(
     margin
 }
 
-/// The suite's planar problem `planar_1_8` (seed 1), planned without the quick attempt
+/// The suite's planar problem `planar_1_8` (seed 1), planned with a margin of L/100
+/// ([`narrow_margin`]), without the quick attempt
 /// (`"quick_attempt": false`; with it, the quick plan's replayed equilibria at the contact
 /// points are the plan) and with fixed tracking targets ([`fixed_targets`]; with the slopes
 /// the own plan coincides): the replayed equilibria of the case's own plan dip into an obstacle
@@ -1093,7 +1098,8 @@ fn an_end_bulging_between_the_verification_grids_points_is_held_clear() {
     }
 }
 
-/// The hanging family's problem `hanging_1_20` (seed 1, `plan_suite --family hanging`),
+/// The hanging family's problem `hanging_1_20` (seed 1, `plan_suite --family hanging`), with a
+/// margin of L/100 ([`narrow_margin`]),
 /// planned with fixed tracking targets ([`fixed_targets`]; with the slopes its optimal path
 /// coincides): a heavy strip whose optimal path departs from its replay, and
 /// no plan of the search is executable on the case's 32 contact samples (the judgement on
