@@ -593,13 +593,17 @@ pub fn run(
     })
 }
 
+/// Where the `q` quantile of `n` sorted values lies: index `round((n − 1) q)`.
+fn percentile_index(n: usize, q: f64) -> usize {
+    ((n - 1) as f64 * q).round() as usize
+}
+
 fn percentile(v: &mut [f64], q: f64) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }
     v.sort_by(f64::total_cmp);
-    let i = ((v.len() - 1) as f64 * q).round() as usize;
-    v[i]
+    v[percentile_index(v.len(), q)]
 }
 
 fn table(kind: &str, out: &[Outcome]) -> String {
@@ -631,6 +635,76 @@ fn table(kind: &str, out: &[Outcome]) -> String {
         percentile(&mut travel.clone(), 0.5),
         percentile(&mut travel, 0.95),
     )
+}
+
+/// The lines `--verbose` writes for outcome `o` (standard error).
+fn report(o: &Outcome) {
+    eprintln!(
+        "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {} replay clearance {:+.2e} converged {} stable {} attempts {}",
+        o.name,
+        o.planned,
+        o.coincide,
+        o.executable,
+        o.snaps,
+        o.u_max,
+        o.deviation,
+        o.travel,
+        o.seconds,
+        // Only plans called collision-free (or executable by their
+        // replayed equilibria) are checked.
+        o.checked_clearance
+            .map_or("unchecked".to_string(), |(d, k)| {
+                format!("{d:+.2e} at k = {k:.4}")
+            }),
+        o.replay.0,
+        o.replay.1,
+        o.replay.2,
+        o.attempts
+    );
+    if let Some(d) = o.by_pose_line {
+        eprintln!(
+            "{:16} executable along a line in the end's pose space {}{}",
+            o.name,
+            match d.describe() {
+                d if d.is_empty() => "lifted 0 L".to_string(),
+                d => d,
+            },
+            o.pose_optimised.map_or(String::new(), |[a, b]| format!(
+                ", optimised: U_max {a:.4} -> {b:.4}"
+            ))
+        );
+    }
+    if let (None, Some([a, b])) = (o.by_pose_line, o.pose_optimised) {
+        eprintln!(
+            "{:16} executable along the {} end poses optimised in the end's pose space: U_max {a:.4} -> {b:.4}",
+            o.name,
+            if o.by_straight {
+                "straight path's"
+            } else {
+                "optimal path's"
+            }
+        );
+    }
+    if o.reached_not_replanned {
+        eprintln!(
+            "{:16} executable by its first search's equilibria, which end on another equilibrium of the goal pose",
+            o.name
+        );
+    } else if o.reached_goal {
+        eprintln!(
+            "{:16} planned to the equilibrium of the goal pose its first plan's motion reached",
+            o.name
+        );
+    }
+    if let Some(why) = &o.why_not {
+        // A departure's or a snap's verdict already says it.
+        let lead = if why.starts_with("not executable") {
+            ""
+        } else {
+            "not executable: "
+        };
+        eprintln!("{:16} {lead}{why}", o.name);
+    }
 }
 
 /// Seeds from `1-16,21,500-523` (ranges inclusive); exits with a message on anything else.
@@ -768,7 +842,7 @@ fn main() {
     };
     let mut all: [Vec<Outcome>; 2] = [Vec::new(), Vec::new()];
     let mut per_seed_p95: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
-    for &seed in &seeds {
+    for (nth, &seed) in seeds.iter().enumerate() {
         // Settings or case fields that no generated problem takes would have every problem
         // generated again, for ever: the first of each kind must be a case.
         for (kind, count) in [(0, n_planar), (1, n_spatial)] {
@@ -825,72 +899,7 @@ fn main() {
                 match run(&text, &name, &plan, &top) {
                     Some(o) => {
                         if verbose {
-                            eprintln!(
-                                "{:16} planned {:5} coincide {:5} executable {:5} snaps {:5} U_max {:.4} d/L {:.4} travel {:.2} time {:.3} s clearance {} replay clearance {:+.2e} converged {} stable {} attempts {}",
-                                o.name,
-                                o.planned,
-                                o.coincide,
-                                o.executable,
-                                o.snaps,
-                                o.u_max,
-                                o.deviation,
-                                o.travel,
-                                o.seconds,
-                                // Only plans called collision-free (or executable by their
-                                // replayed equilibria) are checked.
-                                o.checked_clearance
-                                    .map_or("unchecked".to_string(), |(d, k)| {
-                                        format!("{d:+.2e} at k = {k:.4}")
-                                    }),
-                                o.replay.0,
-                                o.replay.1,
-                                o.replay.2,
-                                o.attempts
-                            );
-                            if let Some(d) = o.by_pose_line {
-                                eprintln!(
-                                    "{:16} executable along a line in the end's pose space {}{}",
-                                    o.name,
-                                    match d.describe() {
-                                        d if d.is_empty() => "lifted 0 L".to_string(),
-                                        d => d,
-                                    },
-                                    o.pose_optimised.map_or(String::new(), |[a, b]| format!(
-                                        ", optimised: U_max {a:.4} -> {b:.4}"
-                                    ))
-                                );
-                            }
-                            if let (None, Some([a, b])) = (o.by_pose_line, o.pose_optimised) {
-                                eprintln!(
-                                    "{:16} executable along the {} end poses optimised in the end's pose space: U_max {a:.4} -> {b:.4}",
-                                    o.name,
-                                    if o.by_straight {
-                                        "straight path's"
-                                    } else {
-                                        "optimal path's"
-                                    }
-                                );
-                            }
-                            if o.reached_not_replanned {
-                                eprintln!(
-                                    "{:16} executable by its first search's equilibria, which end on another equilibrium of the goal pose",
-                                    o.name
-                                );
-                            } else if o.reached_goal {
-                                eprintln!(
-                                    "{:16} planned to the equilibrium of the goal pose its first plan's motion reached",
-                                    o.name
-                                );
-                            }
-                            if let Some(why) = &o.why_not {
-                                // A departure's or a snap's verdict already says it.
-                                let lead = if why.starts_with("not executable") {
-                                    ""
-                                } else {
-                                    "not executable: "
-                                };
-                                eprintln!("{:16} {lead}{why}", o.name);
-                            }
+                            report(&o);
                         }
                         results[kind].push(o);
                     }
@@ -898,7 +907,7 @@ fn main() {
                 }
             }
         }
-        if seed != seeds[0] {
+        if nth > 0 {
             println!();
         }
         println!(
@@ -950,9 +959,9 @@ fn main() {
                 continue;
             }
             let within = p95.iter().filter(|&&t| t <= limit).count();
-            // The pooled percentile is the sorted time at `round((n − 1) · 0.95)`.
+            // The pooled percentile is within the limit while the plans above its place are.
             let n = all[kind].len();
-            let allowed = n - 1 - ((n - 1) as f64 * 0.95).round() as usize;
+            let allowed = n - 1 - percentile_index(n, 0.95);
             let over = all[kind].iter().filter(|o| o.seconds > limit).count();
             let (lo, hi) = p95
                 .iter()
